@@ -1,0 +1,22 @@
+# The two commands of the README. Both run the set-up first; it is quick once done.
+#   make demo   set up, build, and run the main job on the shipped defaults
+#   make test   set up, build, and run every test
+# Extra arguments for the demo: make demo ARGS="--distance 9 --seed 4"
+
+CARGO ?= cargo
+ARGS ?=
+
+.PHONY: demo test lint setup
+
+demo: setup
+	$(CARGO) run --release -p dexcube-cli -- demo $(ARGS)
+
+test: setup
+	$(CARGO) test --release --workspace
+
+lint: setup
+	$(CARGO) fmt --all --check
+	$(CARGO) clippy --release --workspace --all-targets -- -D warnings
+
+setup:
+	@./scripts/setup

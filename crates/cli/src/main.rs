@@ -1,0 +1,46 @@
+//! The `dexcube` binary: a thin clap front end over the workspace's crates. Each subcommand
+//! lives in its own module; errors print one clear line to stderr and exit with status 2.
+
+mod bench;
+mod demo;
+mod net;
+mod solve;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Learning to solve a 2x2x2 Rubik's cube with a simulated Shadow Dexterous Hand.
+#[derive(Parser)]
+#[command(name = "dexcube", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    Solve(solve::SolveArgs),
+    Scramble(solve::ScrambleArgs),
+    Demo(demo::DemoArgs),
+    /// Prints performance figures.
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let outcome = match cli.command {
+        Command::Solve(args) => solve::solve(args),
+        Command::Scramble(args) => solve::scramble(args),
+        Command::Demo(args) => demo::run(args),
+        Command::Bench(command) => bench::run(command),
+    };
+    match outcome {
+        Ok(code) => code,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,126 @@
+//! The `dexcube` binary end to end: answers on stdout, diagnostics on stderr, clean failures.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+fn dexcube(args: &[&str], stdin: &str) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dexcube"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the dexcube binary runs");
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(stdin.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).unwrap()
+}
+
+/// A failure that names its problem on one line, with no panic or backtrace.
+fn assert_clean_failure(o: &Output, code: i32, says: &str) {
+    assert_eq!(o.status.code(), Some(code), "{}", stderr(o));
+    assert!(stderr(o).contains(says), "stderr: {}", stderr(o));
+    assert!(!stderr(o).contains("panicked"), "stderr: {}", stderr(o));
+}
+
+#[test]
+fn solves_facelets_and_scrambles_optimally_with_either_method() {
+    let o = dexcube(&["solve", "UFUFRRRRFDFDDBDBLLLLUBUB"], "");
+    assert!(o.status.success());
+    assert_eq!(stdout(&o), "R'\n");
+    for method in ["table", "ida"] {
+        let o = dexcube(
+            &["solve", "--scramble", "R U F' D2 L B'", "--method", method],
+            "",
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert_eq!(
+            stdout(&o).split_whitespace().count(),
+            7,
+            "{method}: {}",
+            stdout(&o)
+        );
+    }
+}
+
+#[test]
+fn a_solved_cube_prints_an_empty_line() {
+    let o = dexcube(&["solve", "UUUURRRRFFFFDDDDLLLLBBBB"], "");
+    assert!(o.status.success());
+    assert_eq!(stdout(&o), "\n");
+}
+
+#[test]
+fn all_lists_every_optimal_solution() {
+    let o = dexcube(&["solve", "--scramble", "R U2", "--all"], "");
+    assert_eq!(stdout(&o), "U U R'\nU' U' R'\n");
+}
+
+#[test]
+fn bad_input_fails_cleanly_with_a_reason() {
+    let o = dexcube(&["solve", "uuuuRRRRFFFFDDDDLLLLBBBB"], "");
+    assert_clean_failure(&o, 2, "lower-case 'u'");
+    let o = dexcube(&["solve", "UUUURRRRFFFFDDDDLLLLBBB"], "");
+    assert_clean_failure(&o, 2, "wrong length");
+    let o = dexcube(&["solve", "--scramble", "R u"], "");
+    assert_clean_failure(&o, 2, "lower case");
+    let o = dexcube(&["solve", "--batch", "/no/such/file"], "");
+    assert_clean_failure(&o, 2, "cannot open batch file /no/such/file");
+    let o = dexcube(&["scramble", "--distance", "15"], "");
+    assert_clean_failure(&o, 2, "largest distance is 14");
+}
+
+#[test]
+fn batch_answers_every_line_in_order_and_reports_bad_ones() {
+    let input = "UUUURRRRFFFFDDDDLLLLBBBB\nbad\nUUUUBBRRRRFFDDDDFFLLLLBB\n";
+    let o = dexcube(&["solve", "--batch", "-"], input);
+    assert_eq!(stdout(&o), "\nERROR\nU'\n");
+    assert_clean_failure(&o, 1, "line 2: wrong length");
+}
+
+#[test]
+fn scramble_is_reproducible_and_its_output_solves_at_that_distance() {
+    let args = [
+        "scramble",
+        "--distance",
+        "11",
+        "--count",
+        "5",
+        "--seed",
+        "3",
+        "--show-moves",
+    ];
+    let first = stdout(&dexcube(&args, ""));
+    assert_eq!(first, stdout(&dexcube(&args, "")));
+    let cubes: String = first
+        .lines()
+        .map(|l| l.split('\t').next().unwrap().to_owned() + "\n")
+        .collect();
+    let solved = dexcube(&["solve", "--batch", "-"], &cubes);
+    assert!(solved.status.success());
+    for (line, answer) in first.lines().zip(stdout(&solved).lines()) {
+        let scramble = line.split('\t').nth(1).unwrap();
+        assert_eq!(scramble.split_whitespace().count(), 11);
+        assert_eq!(answer.split_whitespace().count(), 11);
+    }
+}
+
+#[test]
+fn demo_solves_its_scramble() {
+    let o = dexcube(&["demo", "--distance", "9", "--seed", "4"], "");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("Optimal plan, 9 quarter turns"));
+    assert!(stdout(&o).trim_end().ends_with("Solved."));
+}
