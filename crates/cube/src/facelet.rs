@@ -272,6 +272,25 @@ impl Facelets {
         moves.iter().fold(*self, |cube, &m| cube.apply(m))
     }
 
+    /// The same cube held in each of its 24 whole-cube orientations, itself first.
+    pub fn orientations(&self) -> Vec<Facelets> {
+        // Opposite face turns together turn the whole cube: x = R L', y = U D'.
+        let x = [Move::new(R, 1), Move::new(L, 3)];
+        let y = [Move::new(U, 1), Move::new(D, 3)];
+        let mut all = vec![*self];
+        let mut i = 0;
+        while i < all.len() {
+            for turn in [&x, &y] {
+                let next = all[i].apply_all(turn);
+                if !all.contains(&next) {
+                    all.push(next);
+                }
+            }
+            i += 1;
+        }
+        all
+    }
+
     /// The same stickers recoloured so that the cubie in slot DBL shows D, B and L, as if the
     /// whole cube were turned to hold that corner at home. Sticker positions do not change, so
     /// a move sequence that solves the recoloured cube solves this one, in this frame.
@@ -401,6 +420,15 @@ mod tests {
             assert_ne!(rotated, Facelets::SOLVED);
             assert_eq!(rotated.recoloured_to_fixed_corner(), Facelets::SOLVED);
         }
+    }
+
+    #[test]
+    fn a_cube_has_24_orientations_that_all_solve_alike() {
+        let scrambled = Facelets::parse(&after("R U F'")).unwrap();
+        let all = scrambled.orientations();
+        assert_eq!(all.len(), 24);
+        assert_eq!(all[0], scrambled);
+        assert_eq!(Facelets::SOLVED.orientations().iter().filter(|c| c.is_solved()).count(), 24);
     }
 
     #[test]

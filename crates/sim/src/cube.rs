@@ -1,0 +1,196 @@
+//! The physical 2x2x2 cube read back from the physics, and turned by hand (kinematically).
+//!
+//! The cube's frame is its DBL cubelet's: x = R, y = B, z = U, origin at the cube's centre.
+//! DBL carries the free joint, and each other cubelet's ball-joint quaternion is its rotation
+//! within that frame. Snapping each rotation to the nearest of the cube's 24 rotations says
+//! which slot the cubelet is in and how it is twisted, which gives the 24 stickers. What is
+//! left over after snapping is the misalignment that the "good state" check bounds.
+
+use std::f64::consts::FRAC_PI_2;
+use std::sync::OnceLock;
+
+use dexcube_cube::facelet::{CORNER_COLOURS, CORNER_FACELETS, CORNER_NAMES, DBL};
+use dexcube_cube::{Face, FaceletError, Facelets, Move};
+
+use crate::rotation::{self, IDENTITY, Quat};
+use crate::scene::ObjectJoints;
+use crate::sim::{Pose, Sim};
+
+/// Misalignment below which a cube is in a "good state": every cubelet within 0.1 rad of a
+/// quarter-turn position, the paper's Stage 2 success threshold.
+pub const ALIGNED_TOLERANCE: f64 = 0.1;
+
+/// The physical cube's state, read from a `cube` scene at one instant.
+#[derive(Clone, Debug)]
+pub struct CubeState {
+    pose: Pose,
+    /// Each cubelet's rotation within the cube frame, by home slot (DBL's is the identity).
+    rotations: [Quat; 8],
+}
+
+impl CubeState {
+    /// Reads the cube; `None` if the simulation is not of the `cube` scene.
+    pub fn read(sim: &Sim) -> Option<CubeState> {
+        let ObjectJoints::Cube { balls, .. } = sim.scene().object() else { return None };
+        let mut rotations = [IDENTITY; 8];
+        for (slot, ball) in balls.iter().enumerate() {
+            rotations[slot] = rotation::normalise(&sim.ball(*ball));
+        }
+        Some(CubeState { pose: sim.object_pose(), rotations })
+    }
+
+    /// The cube's centre and its frame's orientation in the world.
+    pub fn pose(&self) -> Pose {
+        self.pose
+    }
+
+    /// The largest angle between a cubelet's rotation and the nearest quarter-turn position.
+    pub fn misalignment(&self) -> f64 {
+        self.rotations.iter().map(|q| rotation::snap_to_cube(q, group()).1).fold(0.0, f64::max)
+    }
+
+    /// The paper's "good state": every layer within `ALIGNED_TOLERANCE` of a quarter turn.
+    pub fn is_aligned(&self) -> bool {
+        self.misalignment() < ALIGNED_TOLERANCE
+    }
+
+    /// The angle in (-π/4, π/4] of the layer on `face` against the opposite layer, about
+    /// `face`'s outward normal: positive is counter-clockwise seen from outside that face.
+    pub fn layer_angle(&self, face: Face) -> f64 {
+        let axis = face_normal(face);
+        let (mut near, mut far) = (Vec::new(), Vec::new());
+        for (home, q) in self.rotations.iter().enumerate() {
+            let (snapped, _) = rotation::snap_to_cube(q, group());
+            let residual = rotation::mul(q, &rotation::conj(&snapped));
+            let twist = rotation::twist_about(&residual, axis);
+            if dot(rotation::rotate(&snapped, slot_centre(home)), axis) > 0.0 {
+                near.push(twist);
+            } else {
+                far.push(twist);
+            }
+        }
+        mean(&near) - mean(&far)
+    }
+
+    /// The 24 stickers seen in the cube's own frame: DBL is always home, so this is the
+    /// solver's normalised view.
+    pub fn facelets_in_cube_frame(&self) -> Result<Facelets, FaceletError> {
+        self.facelets_seen_from(&IDENTITY)
+    }
+
+    /// The 24 stickers by the world direction they face (U up, R towards +x, B towards +y),
+    /// with the cube's orientation snapped to the nearest axis-aligned one.
+    pub fn facelets_in_world(&self) -> Result<Facelets, FaceletError> {
+        let (frame, _) = rotation::snap_to_cube(&self.pose.orientation, group());
+        self.facelets_seen_from(&frame)
+    }
+
+    fn facelets_seen_from(&self, frame: &Quat) -> Result<Facelets, FaceletError> {
+        let mut stickers = ['?'; 24];
+        for (home, q) in self.rotations.iter().enumerate() {
+            let (snapped, _) = rotation::snap_to_cube(q, group());
+            let g = rotation::mul(frame, &snapped);
+            let slot = slot_at(rotation::rotate(&g, slot_centre(home)));
+            for k in 0..3 {
+                let home_face = Face::ALL[CORNER_FACELETS[home][k] / 4];
+                let face = face_at(rotation::rotate(&g, face_normal(home_face)));
+                let index = CORNER_FACELETS[slot]
+                    .into_iter()
+                    .find(|&i| i / 4 == face as usize)
+                    .expect("a rotated corner sticker faces one of its slot's faces");
+                stickers[index] = CORNER_COLOURS[home][k].letter();
+            }
+        }
+        Facelets::parse(&stickers.iter().collect::<String>())
+    }
+}
+
+/// Turns one face of the cube in the physics by setting joint positions, as a perfect hand
+/// would; velocities of the moved joints are zeroed. Faces are named as seen in the world
+/// (U is the layer facing up, R the one facing +x, B the one facing +y), like
+/// `facelets_in_world`. Call `Sim::forward` (or step) after. Returns `false` if the
+/// simulation is not of the `cube` scene.
+pub fn turn_face(sim: &mut Sim, m: Move) -> bool {
+    turn_face_by(sim, m.face, -(m.quarters as f64) * FRAC_PI_2)
+}
+
+/// Turns the layer facing `face` in the world by `angle` radians about its outward normal
+/// (counter-clockwise seen from outside is positive), kinematically.
+pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
+    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else { return false };
+    let Some(state) = CubeState::read(sim) else { return false };
+    // The same face in the cube's own frame.
+    let (frame, _) = rotation::snap_to_cube(&state.pose.orientation, group());
+    let face = face_at(rotation::rotate(&rotation::conj(&frame), face_normal(face)));
+    let turn = rotation::about(face_normal(face), angle);
+    let in_layer: Vec<bool> = state
+        .rotations
+        .iter()
+        .enumerate()
+        .map(|(home, q)| {
+            let (snapped, _) = rotation::snap_to_cube(q, group());
+            dot(rotation::rotate(&snapped, slot_centre(home)), face_normal(face)) > 0.0
+        })
+        .collect();
+    if in_layer[DBL] {
+        // DBL's layer turns: turn the cube frame with it, and the other layer back.
+        let mut pose = state.pose;
+        pose.orientation = rotation::normalise(&rotation::mul(&pose.orientation, &turn));
+        sim.set_object_pose(&pose);
+        let back = rotation::conj(&turn);
+        for slot in (0..7).filter(|&s| !in_layer[s]) {
+            sim.set_ball(balls[slot], &rotation::normalise(&rotation::mul(&back, &state.rotations[slot])));
+        }
+    } else {
+        for slot in (0..7).filter(|&s| in_layer[s]) {
+            sim.set_ball(balls[slot], &rotation::normalise(&rotation::mul(&turn, &state.rotations[slot])));
+        }
+    }
+    true
+}
+
+fn group() -> &'static [Quat; 24] {
+    static GROUP: OnceLock<[Quat; 24]> = OnceLock::new();
+    GROUP.get_or_init(rotation::cube_rotations)
+}
+
+/// The outward normal of a face in the cube frame (x = R, y = B, z = U).
+pub fn face_normal(face: Face) -> [f64; 3] {
+    match face {
+        Face::U => [0.0, 0.0, 1.0],
+        Face::D => [0.0, 0.0, -1.0],
+        Face::R => [1.0, 0.0, 0.0],
+        Face::L => [-1.0, 0.0, 0.0],
+        Face::B => [0.0, 1.0, 0.0],
+        Face::F => [0.0, -1.0, 0.0],
+    }
+}
+
+/// The direction from the cube's centre to a corner slot (components ±1).
+fn slot_centre(slot: usize) -> [f64; 3] {
+    CORNER_NAMES[slot].chars().fold([0.0; 3], |acc, letter| {
+        let n = face_normal(Face::from_letter(letter).expect("corner names are face letters"));
+        [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
+    })
+}
+
+/// The slot whose direction is nearest `v`.
+fn slot_at(v: [f64; 3]) -> usize {
+    (0..8).max_by(|&a, &b| dot(slot_centre(a), v).total_cmp(&dot(slot_centre(b), v))).unwrap_or(0)
+}
+
+/// The face whose normal is nearest `v`.
+fn face_at(v: [f64; 3]) -> Face {
+    Face::ALL
+        .into_iter()
+        .max_by(|&a, &b| dot(face_normal(a), v).total_cmp(&dot(face_normal(b), v)))
+        .unwrap_or(Face::U)
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn mean(xs: &[f64]) -> f64 {
+    if xs.is_empty() { 0.0 } else { xs.iter().sum::<f64>() / xs.len() as f64 }
+}

@@ -1,0 +1,143 @@
+//! One running simulation of a scene: its own `MjData` over the scene's shared model, a
+//! control step of 20 physics substeps, blow-up detection, and the state every environment
+//! reads (hand joints, the object's pose and velocities).
+
+use std::sync::Arc;
+
+use mujoco_rs::mujoco_c::mjtWarning;
+use mujoco_rs::prelude::*;
+
+use crate::error::SimError;
+use crate::rotation::Quat;
+use crate::scene::{HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene};
+
+/// Physics substeps of 0.002 s per control step, as in Gymnasium-Robotics' hand envs.
+pub const SUBSTEPS: usize = 20;
+
+/// A position and orientation in the world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose {
+    pub position: [f64; 3],
+    pub orientation: Quat,
+}
+
+pub struct Sim {
+    scene: Arc<Scene>,
+    data: MjData<Arc<MjModel>>,
+}
+
+impl Sim {
+    pub fn new(scene: Arc<Scene>) -> Sim {
+        let data = MjData::new(scene.model().clone());
+        let mut sim = Sim { scene, data };
+        sim.reset();
+        sim
+    }
+
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// The raw MuJoCo state, for what this wrapper does not cover.
+    pub fn data(&self) -> &MjData<Arc<MjModel>> {
+        &self.data
+    }
+
+    pub fn data_mut(&mut self) -> &mut MjData<Arc<MjModel>> {
+        &mut self.data
+    }
+
+    /// Back to the model's initial state (the hand's joints at zero, the object on the palm).
+    pub fn reset(&mut self) {
+        self.data.reset();
+        self.data.forward();
+    }
+
+    /// Simulated time in seconds.
+    pub fn time(&self) -> f64 {
+        self.data.ffi().time
+    }
+
+    /// Sets the hand's actuator targets from an action in [-1, 1]^20.
+    pub fn set_action(&mut self, action: &[f64; HAND_ACTUATORS]) {
+        let scene = self.scene.clone();
+        scene.action_to_ctrl(action, &mut self.data.ctrl_mut()[..HAND_ACTUATORS]);
+    }
+
+    /// One control step: `SUBSTEPS` physics steps. Fails if the state blew up, in which case
+    /// the caller should `reset`.
+    pub fn step(&mut self) -> Result<(), SimError> {
+        for _ in 0..SUBSTEPS {
+            self.data.step();
+        }
+        self.check_finite()
+    }
+
+    /// Recomputes positions, contacts and the rest after the state was set by hand.
+    pub fn forward(&mut self) {
+        self.data.forward();
+    }
+
+    fn check_finite(&mut self) -> Result<(), SimError> {
+        let unstable = self.data.warning()[mjtWarning::mjWARN_BADQACC as usize].number > 0;
+        let bad_value = !self.data.qpos().iter().chain(self.data.qvel()).all(|x| x.is_finite());
+        if unstable || bad_value {
+            let what = if unstable {
+                "MuJoCo reported a bad acceleration (mjWARN_BADQACC) and reset the state"
+            } else {
+                "NaN or infinite joint positions or velocities"
+            };
+            return Err(SimError::Diverged { time: self.time(), what: what.to_string() });
+        }
+        Ok(())
+    }
+
+    /// The hand's 24 joint angles (radians).
+    pub fn hand_angles(&self) -> [f64; HAND_JOINTS] {
+        self.scene.hand_joints().map(|j| self.data.qpos()[j.qpos])
+    }
+
+    /// The hand's 24 joint velocities (rad/s).
+    pub fn hand_velocities(&self) -> [f64; HAND_JOINTS] {
+        self.scene.hand_joints().map(|j| self.data.qvel()[j.dof])
+    }
+
+    /// The pose of the object's free joint: the rigid cube's, the block's bottom layer's, or
+    /// the physical cube's (its centre, and DBL's orientation, which is the cube's frame).
+    pub fn object_pose(&self) -> Pose {
+        free_pose(self.data.qpos(), self.scene.object().free())
+    }
+
+    /// Places the object's free joint, with zero velocity.
+    pub fn set_object_pose(&mut self, pose: &Pose) {
+        let free = self.scene.object().free();
+        let qpos = self.data.qpos_mut();
+        qpos[free.qpos..free.qpos + 3].copy_from_slice(&pose.position);
+        qpos[free.qpos + 3..free.qpos + 7].copy_from_slice(&pose.orientation);
+        self.data.qvel_mut()[free.dof..free.dof + 6].fill(0.0);
+    }
+
+    /// The object's linear velocity (world frame, m/s) and angular velocity (rad/s, in the
+    /// object's frame, as MuJoCo stores a free joint's rotation velocity).
+    pub fn object_velocity(&self) -> ([f64; 3], [f64; 3]) {
+        let dof = self.scene.object().free().dof;
+        let v = &self.data.qvel()[dof..dof + 6];
+        ([v[0], v[1], v[2]], [v[3], v[4], v[5]])
+    }
+
+    /// A joint's quaternion coordinates (a ball or free joint's orientation part).
+    pub(crate) fn ball(&self, joint: JointAddress) -> Quat {
+        let q = &self.data.qpos()[joint.qpos..joint.qpos + 4];
+        [q[0], q[1], q[2], q[3]]
+    }
+
+    pub(crate) fn set_ball(&mut self, joint: JointAddress, q: &Quat) {
+        self.data.qpos_mut()[joint.qpos..joint.qpos + 4].copy_from_slice(q);
+        self.data.qvel_mut()[joint.dof..joint.dof + 3].fill(0.0);
+    }
+}
+
+fn free_pose(qpos: &[f64], free: JointAddress) -> Pose {
+    let q = &qpos[free.qpos..free.qpos + 7];
+    Pose { position: [q[0], q[1], q[2]], orientation: [q[3], q[4], q[5], q[6]] }
+}
