@@ -428,7 +428,14 @@ mod tests {
         let all = scrambled.orientations();
         assert_eq!(all.len(), 24);
         assert_eq!(all[0], scrambled);
-        assert_eq!(Facelets::SOLVED.orientations().iter().filter(|c| c.is_solved()).count(), 24);
+        assert_eq!(
+            Facelets::SOLVED
+                .orientations()
+                .iter()
+                .filter(|c| c.is_solved())
+                .count(),
+            24
+        );
     }
 
     #[test]

@@ -11,7 +11,9 @@ fn main() {
             sim.forward();
             let got = CubeState::read(&sim).unwrap().facelets_in_world().unwrap();
             let want = Facelets::SOLVED.apply(a).apply(b);
-            if got != want { print!("{a} {b}; "); }
+            if got != want {
+                print!("{a} {b}; ");
+            }
         }
     }
     println!();

@@ -16,6 +16,17 @@ use crate::rotation::{self, IDENTITY, Quat};
 use crate::scene::ObjectJoints;
 use crate::sim::{Pose, Sim};
 
+/// The detent that pulls each cubelet towards the nearest quarter-turn position, as the
+/// magnets of a speed cube do: torque `DETENT_STIFFNESS · θ · (1 − θ / DETENT_CAPTURE)` for
+/// a misalignment θ below the capture angle, none beyond. Chamfers alone cannot tolerate 5°:
+/// with U off by θ, turning R by φ drives the tilted URF|UFL face about 25 mm · θ · φ into
+/// UFL, so a 0.2 mm gap allows about 0.5°, and the contact pushes URF and UFL opposite ways
+/// about z, giving the U layer no net push back. The detent re-aligns a layer that the hand
+/// lets go of within the capture angle, so the next turn goes through, as on a real cube.
+pub const DETENT_STIFFNESS: f64 = 0.09;
+/// Beyond this misalignment (0.1 rad, 5.7°: the good-state tolerance) the detent lets go.
+pub const DETENT_CAPTURE: f64 = ALIGNED_TOLERANCE;
+
 /// Misalignment below which a cube is in a "good state": every cubelet within 0.1 rad of a
 /// quarter-turn position, the paper's Stage 2 success threshold.
 pub const ALIGNED_TOLERANCE: f64 = 0.1;
@@ -31,12 +42,17 @@ pub struct CubeState {
 impl CubeState {
     /// Reads the cube; `None` if the simulation is not of the `cube` scene.
     pub fn read(sim: &Sim) -> Option<CubeState> {
-        let ObjectJoints::Cube { balls, .. } = sim.scene().object() else { return None };
+        let ObjectJoints::Cube { balls, .. } = sim.scene().object() else {
+            return None;
+        };
         let mut rotations = [IDENTITY; 8];
         for (slot, ball) in balls.iter().enumerate() {
             rotations[slot] = rotation::normalise(&sim.ball(*ball));
         }
-        Some(CubeState { pose: sim.object_pose(), rotations })
+        Some(CubeState {
+            pose: sim.object_pose(),
+            rotations,
+        })
     }
 
     /// The cube's centre and its frame's orientation in the world.
@@ -44,9 +60,18 @@ impl CubeState {
         self.pose
     }
 
+    /// The rotation of the cubelet whose home is `slot` (cube crate order), within the cube
+    /// frame; DBL's is the identity.
+    pub fn cubelet_rotation(&self, slot: usize) -> Quat {
+        self.rotations[slot]
+    }
+
     /// The largest angle between a cubelet's rotation and the nearest quarter-turn position.
     pub fn misalignment(&self) -> f64 {
-        self.rotations.iter().map(|q| rotation::snap_to_cube(q, group()).1).fold(0.0, f64::max)
+        self.rotations
+            .iter()
+            .map(|q| rotation::snap_to_cube(q, group()).1)
+            .fold(0.0, f64::max)
     }
 
     /// The paper's "good state": every layer within `ALIGNED_TOLERANCE` of a quarter turn.
@@ -117,8 +142,12 @@ pub fn turn_face(sim: &mut Sim, m: Move) -> bool {
 /// Turns the layer facing `face` in the world by `angle` radians about its outward normal
 /// (counter-clockwise seen from outside is positive), kinematically.
 pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
-    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else { return false };
-    let Some(state) = CubeState::read(sim) else { return false };
+    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else {
+        return false;
+    };
+    let Some(state) = CubeState::read(sim) else {
+        return false;
+    };
     // The same face in the cube's own frame.
     let (frame, _) = rotation::snap_to_cube(&state.pose.orientation, group());
     let face = face_at(rotation::rotate(&rotation::conj(&frame), face_normal(face)));
@@ -129,7 +158,10 @@ pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
         .enumerate()
         .map(|(home, q)| {
             let (snapped, _) = rotation::snap_to_cube(q, group());
-            dot(rotation::rotate(&snapped, slot_centre(home)), face_normal(face)) > 0.0
+            dot(
+                rotation::rotate(&snapped, slot_centre(home)),
+                face_normal(face),
+            ) > 0.0
         })
         .collect();
     if in_layer[DBL] {
@@ -139,14 +171,49 @@ pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
         sim.set_object_pose(&pose);
         let back = rotation::conj(&turn);
         for slot in (0..7).filter(|&s| !in_layer[s]) {
-            sim.set_ball(balls[slot], &rotation::normalise(&rotation::mul(&back, &state.rotations[slot])));
+            sim.set_ball(
+                balls[slot],
+                &rotation::normalise(&rotation::mul(&back, &state.rotations[slot])),
+            );
         }
     } else {
         for slot in (0..7).filter(|&s| in_layer[s]) {
-            sim.set_ball(balls[slot], &rotation::normalise(&rotation::mul(&turn, &state.rotations[slot])));
+            sim.set_ball(
+                balls[slot],
+                &rotation::normalise(&rotation::mul(&turn, &state.rotations[slot])),
+            );
         }
     }
     true
+}
+
+/// Sets each cubelet's detent torque as an applied joint force, for the next physics step.
+pub(crate) fn apply_detent(sim: &mut Sim) {
+    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else {
+        return;
+    };
+    for ball in balls {
+        let q = rotation::normalise(&sim.ball(ball));
+        let (snapped, angle) = rotation::snap_to_cube(&q, group());
+        let torque = if angle < 1e-9 || angle >= DETENT_CAPTURE {
+            [0.0; 3]
+        } else {
+            // The residual rotation's axis, in the cubelet's own frame (ball joints' velocity
+            // coordinates), pushed back with the detent's profile.
+            let mut residual = rotation::mul(&rotation::conj(&snapped), &q);
+            if residual[0] < 0.0 {
+                residual = residual.map(|x| -x);
+            }
+            let norm = (residual[1].powi(2) + residual[2].powi(2) + residual[3].powi(2)).sqrt();
+            let size = DETENT_STIFFNESS * angle * (1.0 - angle / DETENT_CAPTURE) / norm;
+            [
+                -residual[1] * size,
+                -residual[2] * size,
+                -residual[3] * size,
+            ]
+        };
+        sim.data_mut().qfrc_applied_mut()[ball.dof..ball.dof + 3].copy_from_slice(&torque);
+    }
 }
 
 fn group() -> &'static [Quat; 24] {
@@ -176,7 +243,9 @@ fn slot_centre(slot: usize) -> [f64; 3] {
 
 /// The slot whose direction is nearest `v`.
 fn slot_at(v: [f64; 3]) -> usize {
-    (0..8).max_by(|&a, &b| dot(slot_centre(a), v).total_cmp(&dot(slot_centre(b), v))).unwrap_or(0)
+    (0..8)
+        .max_by(|&a, &b| dot(slot_centre(a), v).total_cmp(&dot(slot_centre(b), v)))
+        .unwrap_or(0)
 }
 
 /// The face whose normal is nearest `v`.
@@ -192,5 +261,9 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 fn mean(xs: &[f64]) -> f64 {
-    if xs.is_empty() { 0.0 } else { xs.iter().sum::<f64>() / xs.len() as f64 }
+    if xs.is_empty() {
+        0.0
+    } else {
+        xs.iter().sum::<f64>() / xs.len() as f64
+    }
 }

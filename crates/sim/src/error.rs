@@ -6,13 +6,20 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, PartialEq)]
 pub enum SimError {
     /// The linked MuJoCo library is not the version the bindings were generated for.
-    VersionMismatch { found: String, expected: &'static str },
+    VersionMismatch {
+        found: String,
+        expected: &'static str,
+    },
     /// A scene file, or the Shadow Hand model it includes, is not on disk.
     MissingAsset { path: PathBuf },
     /// MuJoCo refused the model.
     Load { path: PathBuf, message: String },
     /// The model lacks a joint, body or actuator the scene needs.
-    MissingElement { path: PathBuf, kind: &'static str, name: String },
+    MissingElement {
+        path: PathBuf,
+        kind: &'static str,
+        name: String,
+    },
     /// The simulation produced NaN or infinite values, or MuJoCo flagged an unstable state.
     Diverged { time: f64, what: String },
 }

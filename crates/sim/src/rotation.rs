@@ -89,6 +89,8 @@ mod tests {
         }
         let (snapped, error) = snap_to_cube(&about([0.0, 0.0, 1.0], 1.65), &all);
         assert!((error - (1.65 - std::f64::consts::FRAC_PI_2)).abs() < 1e-9);
-        assert!((twist_about(&snapped, [0.0, 0.0, 1.0]) - std::f64::consts::FRAC_PI_2).abs() < 1e-9);
+        assert!(
+            (twist_about(&snapped, [0.0, 0.0, 1.0]) - std::f64::consts::FRAC_PI_2).abs() < 1e-9
+        );
     }
 }

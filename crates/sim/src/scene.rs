@@ -62,12 +62,21 @@ pub fn assets_dir() -> PathBuf {
 #[derive(Clone, Debug)]
 pub enum ObjectJoints {
     /// The rigid cube's free joint, and the ghost target's mocap index.
-    Rot { free: JointAddress, target_mocap: usize },
+    Rot {
+        free: JointAddress,
+        target_mocap: usize,
+    },
     /// The block's free joint and the hinge between its layers.
-    Layer { free: JointAddress, hinge: JointAddress },
+    Layer {
+        free: JointAddress,
+        hinge: JointAddress,
+    },
     /// DBL's free joint, and the ball joints of the other seven cubelets in the cube crate's
     /// slot order (URF, UFL, ULB, UBR, DFR, DLF, DRB).
-    Cube { free: JointAddress, balls: [JointAddress; 7] },
+    Cube {
+        free: JointAddress,
+        balls: [JointAddress; 7],
+    },
 }
 
 impl ObjectJoints {
@@ -110,7 +119,10 @@ impl Scene {
     pub fn load_from(kind: SceneKind, assets: &Path) -> Result<Arc<Scene>, SimError> {
         let found = mujoco_rs::mujoco_version();
         if found != MUJOCO_VERSION {
-            return Err(SimError::VersionMismatch { found: found.to_string(), expected: MUJOCO_VERSION });
+            return Err(SimError::VersionMismatch {
+                found: found.to_string(),
+                expected: MUJOCO_VERSION,
+            });
         }
         let path = kind.path_in(assets);
         for needed in [path.clone(), assets.join("shadow_hand/hand/robot.xml")] {
@@ -122,7 +134,10 @@ impl Scene {
             path: path.clone(),
             message: e.to_string().trim().to_string(),
         })?;
-        let lookup = Lookup { model: &model, path: &path };
+        let lookup = Lookup {
+            model: &model,
+            path: &path,
+        };
         let hand_joints = collect_array(HAND_JOINT_NAMES.map(|n| lookup.joint(n)))?;
         let mut ctrl_centre = [0.0; HAND_ACTUATORS];
         let mut ctrl_half_range = [0.0; HAND_ACTUATORS];
@@ -202,11 +217,13 @@ struct Lookup<'a> {
 
 impl Lookup<'_> {
     fn id(&self, kind: MjtObjBase, what: &'static str, name: &str) -> Result<usize, SimError> {
-        self.model.name_to_id(kind, name).ok_or_else(|| SimError::MissingElement {
-            path: self.path.to_path_buf(),
-            kind: what,
-            name: name.to_string(),
-        })
+        self.model
+            .name_to_id(kind, name)
+            .ok_or_else(|| SimError::MissingElement {
+                path: self.path.to_path_buf(),
+                kind: what,
+                name: name.to_string(),
+            })
     }
 
     fn joint(&self, name: &str) -> Result<JointAddress, SimError> {
@@ -230,21 +247,53 @@ fn collect_array<const N: usize>(
 
 /// The hand's joints in Gymnasium-Robotics' order.
 const HAND_JOINT_NAMES: [&str; HAND_JOINTS] = [
-    "robot0:WRJ1", "robot0:WRJ0",
-    "robot0:FFJ3", "robot0:FFJ2", "robot0:FFJ1", "robot0:FFJ0",
-    "robot0:MFJ3", "robot0:MFJ2", "robot0:MFJ1", "robot0:MFJ0",
-    "robot0:RFJ3", "robot0:RFJ2", "robot0:RFJ1", "robot0:RFJ0",
-    "robot0:LFJ4", "robot0:LFJ3", "robot0:LFJ2", "robot0:LFJ1", "robot0:LFJ0",
-    "robot0:THJ4", "robot0:THJ3", "robot0:THJ2", "robot0:THJ1", "robot0:THJ0",
+    "robot0:WRJ1",
+    "robot0:WRJ0",
+    "robot0:FFJ3",
+    "robot0:FFJ2",
+    "robot0:FFJ1",
+    "robot0:FFJ0",
+    "robot0:MFJ3",
+    "robot0:MFJ2",
+    "robot0:MFJ1",
+    "robot0:MFJ0",
+    "robot0:RFJ3",
+    "robot0:RFJ2",
+    "robot0:RFJ1",
+    "robot0:RFJ0",
+    "robot0:LFJ4",
+    "robot0:LFJ3",
+    "robot0:LFJ2",
+    "robot0:LFJ1",
+    "robot0:LFJ0",
+    "robot0:THJ4",
+    "robot0:THJ3",
+    "robot0:THJ2",
+    "robot0:THJ1",
+    "robot0:THJ0",
 ];
 
 /// The hand's position actuators in Gymnasium-Robotics' order (the distal joints J0 of the
 /// four fingers follow J1 through tendons).
 const HAND_ACTUATOR_NAMES: [&str; HAND_ACTUATORS] = [
-    "robot0:A_WRJ1", "robot0:A_WRJ0",
-    "robot0:A_FFJ3", "robot0:A_FFJ2", "robot0:A_FFJ1",
-    "robot0:A_MFJ3", "robot0:A_MFJ2", "robot0:A_MFJ1",
-    "robot0:A_RFJ3", "robot0:A_RFJ2", "robot0:A_RFJ1",
-    "robot0:A_LFJ4", "robot0:A_LFJ3", "robot0:A_LFJ2", "robot0:A_LFJ1",
-    "robot0:A_THJ4", "robot0:A_THJ3", "robot0:A_THJ2", "robot0:A_THJ1", "robot0:A_THJ0",
+    "robot0:A_WRJ1",
+    "robot0:A_WRJ0",
+    "robot0:A_FFJ3",
+    "robot0:A_FFJ2",
+    "robot0:A_FFJ1",
+    "robot0:A_MFJ3",
+    "robot0:A_MFJ2",
+    "robot0:A_MFJ1",
+    "robot0:A_RFJ3",
+    "robot0:A_RFJ2",
+    "robot0:A_RFJ1",
+    "robot0:A_LFJ4",
+    "robot0:A_LFJ3",
+    "robot0:A_LFJ2",
+    "robot0:A_LFJ1",
+    "robot0:A_THJ4",
+    "robot0:A_THJ3",
+    "robot0:A_THJ2",
+    "robot0:A_THJ1",
+    "robot0:A_THJ0",
 ];

@@ -9,7 +9,7 @@ use mujoco_rs::prelude::*;
 
 use crate::error::SimError;
 use crate::rotation::Quat;
-use crate::scene::{HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene};
+use crate::scene::{HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene, SceneKind};
 
 /// Physics substeps of 0.002 s per control step, as in Gymnasium-Robotics' hand envs.
 pub const SUBSTEPS: usize = 20;
@@ -67,7 +67,11 @@ impl Sim {
     /// One control step: `SUBSTEPS` physics steps. Fails if the state blew up, in which case
     /// the caller should `reset`.
     pub fn step(&mut self) -> Result<(), SimError> {
+        let detent = matches!(self.scene.kind(), SceneKind::Cube);
         for _ in 0..SUBSTEPS {
+            if detent {
+                crate::cube::apply_detent(self);
+            }
             self.data.step();
         }
         self.check_finite()
@@ -80,14 +84,22 @@ impl Sim {
 
     fn check_finite(&mut self) -> Result<(), SimError> {
         let unstable = self.data.warning()[mjtWarning::mjWARN_BADQACC as usize].number > 0;
-        let bad_value = !self.data.qpos().iter().chain(self.data.qvel()).all(|x| x.is_finite());
+        let bad_value = !self
+            .data
+            .qpos()
+            .iter()
+            .chain(self.data.qvel())
+            .all(|x| x.is_finite());
         if unstable || bad_value {
             let what = if unstable {
                 "MuJoCo reported a bad acceleration (mjWARN_BADQACC) and reset the state"
             } else {
                 "NaN or infinite joint positions or velocities"
             };
-            return Err(SimError::Diverged { time: self.time(), what: what.to_string() });
+            return Err(SimError::Diverged {
+                time: self.time(),
+                what: what.to_string(),
+            });
         }
         Ok(())
     }
@@ -139,5 +151,8 @@ impl Sim {
 
 fn free_pose(qpos: &[f64], free: JointAddress) -> Pose {
     let q = &qpos[free.qpos..free.qpos + 7];
-    Pose { position: [q[0], q[1], q[2]], orientation: [q[3], q[4], q[5], q[6]] }
+    Pose {
+        position: [q[0], q[1], q[2]],
+        orientation: [q[3], q[4], q[5], q[6]],
+    }
 }

@@ -9,7 +9,10 @@ fn cube_sim() -> Sim {
     let mut sim = Sim::new(Scene::load(SceneKind::Cube).expect("run scripts/setup first"));
     // Hold the cube in free space above the floor, away from the hand, so settling tests
     // see only the cube's own mechanics.
-    let pose = Pose { position: [1.3, 0.6, 0.3], orientation: rotation::IDENTITY };
+    let pose = Pose {
+        position: [1.3, 0.6, 0.3],
+        orientation: rotation::IDENTITY,
+    };
     sim.set_object_pose(&pose);
     sim.forward();
     sim
@@ -35,8 +38,16 @@ fn each_quarter_turn_reads_back_as_the_cube_crate_says() {
         let state = read(&sim);
         let expected = Facelets::SOLVED.apply(m);
         assert_eq!(state.facelets_in_world().unwrap(), expected, "{m}");
-        assert!(state.is_aligned(), "{m}: misaligned by {}", state.misalignment());
-        assert!(expected.orientations().contains(&state.facelets_in_cube_frame().unwrap()));
+        assert!(
+            state.is_aligned(),
+            "{m}: misaligned by {}",
+            state.misalignment()
+        );
+        assert!(
+            expected
+                .orientations()
+                .contains(&state.facelets_in_cube_frame().unwrap())
+        );
     }
 }
 
@@ -58,9 +69,21 @@ fn random_sequences_read_back_after_settling() {
         assert_eq!(read(&sim).facelets_in_world().unwrap(), expected);
         settle(&mut sim, 25);
         let state = read(&sim);
-        assert!(state.is_aligned(), "misaligned by {} after settling", state.misalignment());
-        assert!(expected.orientations().contains(&state.facelets_in_cube_frame().unwrap()));
-        assert!(expected.orientations().contains(&state.facelets_in_world().unwrap()));
+        assert!(
+            state.is_aligned(),
+            "misaligned by {} after settling",
+            state.misalignment()
+        );
+        assert!(
+            expected
+                .orientations()
+                .contains(&state.facelets_in_cube_frame().unwrap())
+        );
+        assert!(
+            expected
+                .orientations()
+                .contains(&state.facelets_in_world().unwrap())
+        );
     }
 }
 
@@ -86,7 +109,11 @@ fn a_tumbled_cube_still_reads_correctly() {
     sim.forward();
     let state = read(&sim);
     assert_eq!(state.facelets_in_cube_frame().unwrap(), own_view);
-    assert!(expected.orientations().contains(&state.facelets_in_world().unwrap()));
+    assert!(
+        expected
+            .orientations()
+            .contains(&state.facelets_in_world().unwrap())
+    );
 }
 
 #[test]
@@ -95,8 +122,15 @@ fn partial_turns_show_as_layer_angle_and_misalignment() {
     turn_face_by(&mut sim, Face::U, 0.3);
     sim.forward();
     let state = read(&sim);
-    assert!((state.layer_angle(Face::U) - 0.3).abs() < 1e-9, "{}", state.layer_angle(Face::U));
-    assert!((state.layer_angle(Face::D) - 0.3).abs() < 1e-9, "D against U is the same turn");
+    assert!(
+        (state.layer_angle(Face::U) - 0.3).abs() < 1e-9,
+        "{}",
+        state.layer_angle(Face::U)
+    );
+    assert!(
+        (state.layer_angle(Face::D) - 0.3).abs() < 1e-9,
+        "D against U is the same turn"
+    );
     assert!(state.layer_angle(Face::R).abs() < 1e-9);
     assert!(!state.is_aligned());
     assert!((state.misalignment() - 0.3).abs() < 1e-9);
@@ -107,19 +141,39 @@ fn partial_turns_show_as_layer_angle_and_misalignment() {
 
 #[test]
 fn a_shearing_push_leaves_a_valid_cube() {
+    use mujoco_rs::wrappers::mj_model::MjtObjBase;
     let mut sim = cube_sim();
-    let urf = sim
-        .scene()
-        .model()
-        .name_to_id(mujoco_rs::wrappers::mj_model::MjtObjBase::mjOBJ_BODY, "cubelet:URF")
-        .unwrap();
-    // 20 N sideways on one corner cubelet for 0.2 s: far more than a finger applies.
+    let body = |sim: &Sim, c: &str| {
+        sim.scene()
+            .model()
+            .name_to_id(MjtObjBase::mjOBJ_BODY, &format!("cubelet:{c}"))
+            .unwrap()
+    };
+    let top: Vec<usize> = ["URF", "UFL", "ULB", "UBR"]
+        .iter()
+        .map(|c| body(&sim, c))
+        .collect();
+    let bottom: Vec<usize> = ["DFR", "DLF", "DRB", "DBL"]
+        .iter()
+        .map(|c| body(&sim, c))
+        .collect();
+    // 2 N on each cubelet, top layer one way and bottom layer the other, for 0.1 s: twice
+    // what a fingertip's actuator can push, sheared across the layers.
     for step in 0..30 {
-        sim.data_mut().xfrc_applied_mut()[urf] = if step < 5 { [0.0, 20.0, 0.0, 0.0, 0.0, 0.0] } else { [0.0; 6] };
+        let force = if step < 5 { 2.0 } else { 0.0 };
+        for (bodies, sign) in [(&top, 1.0), (&bottom, -1.0)] {
+            for &b in bodies {
+                sim.data_mut().xfrc_applied_mut()[b] =
+                    [sign * force, 0.5 * sign * force, 0.0, 0.0, 0.0, 0.0];
+            }
+        }
         sim.step().expect("stable under a hard push");
     }
     let state = read(&sim);
-    assert!(state.facelets_in_cube_frame().is_ok(), "not a valid cube after the push");
+    assert!(
+        state.facelets_in_cube_frame().is_ok(),
+        "not a valid cube after the push"
+    );
 }
 
 #[test]
@@ -130,4 +184,54 @@ fn a_dropped_cube_holds_together() {
     assert!(state.pose().position[2] < 0.05, "it fell to the floor");
     assert_eq!(state.facelets_in_cube_frame().unwrap(), Facelets::SOLVED);
     assert!(state.is_aligned(), "misaligned by {}", state.misalignment());
+}
+
+/// Twists the R layer against the L layer with `torque` N·m per cubelet for `steps` control
+/// steps, after turning U by `u_angle`; returns how far URF turned about x.
+fn twist_r_against_l(u_angle: f64, torque: f64, steps: usize) -> f64 {
+    use mujoco_rs::wrappers::mj_model::MjtObjBase;
+    let mut sim = cube_sim();
+    turn_face_by(&mut sim, Face::U, u_angle);
+    sim.forward();
+    let start = read(&sim).cubelet_rotation(0);
+    let body = |sim: &Sim, c: &str| {
+        sim.scene()
+            .model()
+            .name_to_id(MjtObjBase::mjOBJ_BODY, &format!("cubelet:{c}"))
+            .unwrap()
+    };
+    let right: Vec<usize> = ["URF", "UBR", "DFR", "DRB"]
+        .iter()
+        .map(|c| body(&sim, c))
+        .collect();
+    let left: Vec<usize> = ["UFL", "ULB", "DLF", "DBL"]
+        .iter()
+        .map(|c| body(&sim, c))
+        .collect();
+    for _ in 0..steps {
+        for (bodies, sign) in [(&right, -1.0), (&left, 1.0)] {
+            for &b in bodies {
+                sim.data_mut().xfrc_applied_mut()[b] = [0.0, 0.0, 0.0, sign * torque, 0.0, 0.0];
+            }
+        }
+        sim.step().expect("stable while twisted");
+    }
+    let now = read(&sim).cubelet_rotation(0);
+    rotation::twist_about(
+        &rotation::mul(&now, &rotation::conj(&start)),
+        [1.0, 0.0, 0.0],
+    )
+    .abs()
+}
+
+#[test]
+fn only_aligned_layers_turn() {
+    let free = twist_r_against_l(0.0, 0.01, 6);
+    assert!(free > 0.3, "an aligned cube's R layer turns: {free}");
+    let nearly = twist_r_against_l(4f64.to_radians(), 0.01, 6);
+    assert!(nearly > 0.3, "4° of misalignment is tolerated: {nearly}");
+    for degrees in [15.0, 45.0] {
+        let blocked = twist_r_against_l(f64::to_radians(degrees), 0.01, 6);
+        assert!(blocked < 0.1, "U turned {degrees}° blocks R: {blocked}");
+    }
 }
