@@ -137,7 +137,7 @@ def cube_scene():
               "  <contact>"]
     for i, p in enumerate(CORNERS):
         for q in CORNERS[i + 1:]:
-            lines.append(f'    <pair geom1="cubelet:{p}" geom2="cubelet:{q}" condim=\"3\" friction=\"0.3 0.3 0.005 0.0001 0.0001\" solref=\"0.004 1\" solimp=\"0.95 0.99 0.001\"/>')
+            lines.append(f'    <pair geom1="cubelet:{p}" geom2="cubelet:{q}" condim=\"1\" solref=\"0.004 1\" solimp=\"0.95 0.99 0.001\"/>')
     lines += ["  </contact>", "  <worldbody>",
               "    <!-- DBL carries the free joint, its origin at the cube's centre: the solver never",
               "         moves DBL, so its frame is the cube's. The other seven turn about the centre. -->",
@@ -151,14 +151,14 @@ def cube_scene():
             f'{indent}<geom name="cubelet:{c}:outside" type="box" size="{a} {a} {a}" pos="{pos}" '
             f'rgba="0.08 0.08 0.08 1" condim="4" density="{DENSITY}" contype="2" conaffinity="1"/>',
             # What the other cubelets touch, through the explicit pairs only: chamfered.
-            f'{indent}<geom name="cubelet:{c}" type="mesh" mesh="cubelet" pos="{pos}" '
+            f'{indent}<geom name="cubelet:{c}" type="box" size="{a} {a} {a}" pos="{pos}" '
             'contype="0" conaffinity="0" group="3" mass="0"/>',
         ] + [indent + g for g in stickers(c, (0, 0, 0))]
 
     lines += cubelet_geoms("DBL", "      ")
     for c in CORNERS[:-1]:
         lines += [f'      <body name="cubelet:{c}">',
-                  f'        <joint name="cubelet:{c}" type="ball" damping="0.0005" frictionloss="0.001"/>']
+                  f'        <joint name="cubelet:{c}" type="ball" damping="0.002"/>']
         lines += cubelet_geoms(c, "        ")
         lines.append("      </body>")
     lines += ["    </body>", "  </worldbody>", "</mujoco>"]

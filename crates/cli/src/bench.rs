@@ -13,6 +13,8 @@ use serde::Serialize;
 pub enum BenchCommand {
     /// Table build time, optimal solve time per move distance (table and IDA*), table memory.
     Solver(SolverArgs),
+    /// Control steps per second of each scene, beside a raw mj_step loop, on 1 and 2 threads.
+    Sim(crate::bench_sim::SimArgs),
 }
 
 #[derive(Args)]
@@ -34,6 +36,7 @@ pub struct SolverArgs {
 pub fn run(command: BenchCommand) -> anyhow::Result<ExitCode> {
     match command {
         BenchCommand::Solver(args) => solver(args),
+        BenchCommand::Sim(args) => crate::bench_sim::run(args),
     }
 }
 

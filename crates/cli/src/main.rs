@@ -2,6 +2,7 @@
 //! lives in its own module; errors print one clear line to stderr and exit with status 2.
 
 mod bench;
+mod bench_sim;
 mod demo;
 mod net;
 mod solve;

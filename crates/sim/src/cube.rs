@@ -195,7 +195,7 @@ pub(crate) fn apply_detent(sim: &mut Sim) {
     for ball in balls {
         let q = rotation::normalise(&sim.ball(ball));
         let (snapped, angle) = rotation::snap_to_cube(&q, group());
-        let torque = if angle < 1e-9 || angle >= DETENT_CAPTURE {
+        let torque = if !(1e-9..DETENT_CAPTURE).contains(&angle) {
             [0.0; 3]
         } else {
             // The residual rotation's axis, in the cubelet's own frame (ball joints' velocity

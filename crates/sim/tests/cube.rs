@@ -228,9 +228,10 @@ fn twist_r_against_l(u_angle: f64, torque: f64, steps: usize) -> f64 {
 fn only_aligned_layers_turn() {
     let free = twist_r_against_l(0.0, 0.01, 6);
     assert!(free > 0.3, "an aligned cube's R layer turns: {free}");
-    let nearly = twist_r_against_l(4f64.to_radians(), 0.01, 6);
-    assert!(nearly > 0.3, "4° of misalignment is tolerated: {nearly}");
-    for degrees in [15.0, 45.0] {
+    // The paper's cube tolerates about 5° of misalignment; ours turns at 5° and jams at 8°.
+    let nearly = twist_r_against_l(5f64.to_radians(), 0.01, 6);
+    assert!(nearly > 0.3, "5° of misalignment is tolerated: {nearly}");
+    for degrees in [8.0, 15.0, 45.0] {
         let blocked = twist_r_against_l(f64::to_radians(degrees), 0.01, 6);
         assert!(blocked < 0.1, "U turned {degrees}° blocks R: {blocked}");
     }
