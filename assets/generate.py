@@ -10,7 +10,6 @@ HERE = Path(__file__).resolve().parent
 HALF = 0.025                     # half the cube's edge: a 5 cm cube of 2.5 cm cubelets
 CUBELET = HALF / 2               # a cubelet's half edge
 GAP = 0.0002                     # clearance between neighbouring cubelets
-CHAMFER = 0.003                  # depth of the cut on each cubelet edge and corner
 PALM = (1.0, 0.87, 0.2)          # Gymnasium-Robotics' block start, resting on the palm
 DENSITY = 567                    # Gymnasium-Robotics' block: about 71 g for 5 cm
 
@@ -59,16 +58,6 @@ def stickers(corner, centre_offset, alpha=1.0, prefix=""):
             f'rgba="{rgba}" contype="0" conaffinity="0" group="1" mass="0"/>'
         )
     return out
-
-
-def chamfered_cube_vertices(a, b):
-    """Convex hull points of a cube of half edge a with edges and corners cut to depth a - b."""
-    pts = []
-    for sx in (-1, 1):
-        for sy in (-1, 1):
-            for sz in (-1, 1):
-                pts += [(sx * a, sy * a, sz * b), (sx * a, sy * b, sz * a), (sx * b, sy * a, sz * a)]
-    return " ".join(fmt(p) for p in pts)
 
 
 def header(title):
@@ -128,16 +117,16 @@ def layer_scene():
 def cube_scene():
     a = CUBELET - GAP / 2
     lines = header("cube: a physical 2x2x2 cube, eight cubelets on ball joints at its centre")
-    lines += ["  <asset>",
-              f'    <mesh name="cubelet" vertex="{chamfered_cube_vertices(a, a - CHAMFER)}"/>',
-              "  </asset>",
-              "  <!-- Any two cubelets can become neighbours after some turns, so every pair may touch;",
-              "       the gap and chamfers keep an aligned cube free of contacts between cubelets.",
-              "       Frictionless: a layer's resistance to turning is its ball joints' dry friction. -->",
+    lines += ["  <!-- Any two cubelets become neighbours after some turns, so all 28 pairs may touch.",
+              "       Stiff (solref 0.004): with MuJoCo's default a 9 g cubelet under a fingertip's",
+              "       0.5 N sinks centimetres into its neighbour and a jammed cube flexes. Frictionless:",
+              "       one constraint row per contact; a layer's resistance to turning is its ball",
+              "       joints' damping, and its alignment the detent in crates/sim/src/cube.rs. -->",
               "  <contact>"]
     for i, p in enumerate(CORNERS):
         for q in CORNERS[i + 1:]:
-            lines.append(f'    <pair geom1="cubelet:{p}" geom2="cubelet:{q}" condim=\"1\" solref=\"0.004 1\" solimp=\"0.95 0.99 0.001\"/>')
+            lines.append(f'    <pair geom1="cubelet:{p}" geom2="cubelet:{q}" condim="1" '
+                         'solref="0.004 1" solimp="0.95 0.99 0.001"/>')
     lines += ["  </contact>", "  <worldbody>",
               "    <!-- DBL carries the free joint, its origin at the cube's centre: the solver never",
               "         moves DBL, so its frame is the cube's. The other seven turn about the centre. -->",
@@ -145,14 +134,12 @@ def cube_scene():
               '      <freejoint name="cube:joint"/>']
 
     def cubelet_geoms(c, indent):
+        # The hand and the floor touch the box through contype/conaffinity; cubelets touch
+        # each other only through the explicit pairs, with their own stiffer contacts.
         pos = fmt([s * CUBELET for s in corner_sign(c)])
         return [
-            # What the hand and the floor touch: a plain box, the cheapest collision there is.
-            f'{indent}<geom name="cubelet:{c}:outside" type="box" size="{a} {a} {a}" pos="{pos}" '
-            f'rgba="0.08 0.08 0.08 1" condim="4" density="{DENSITY}" contype="2" conaffinity="1"/>',
-            # What the other cubelets touch, through the explicit pairs only: chamfered.
             f'{indent}<geom name="cubelet:{c}" type="box" size="{a} {a} {a}" pos="{pos}" '
-            'contype="0" conaffinity="0" group="3" mass="0"/>',
+            f'rgba="0.08 0.08 0.08 1" condim="4" density="{DENSITY}" contype="2" conaffinity="1"/>',
         ] + [indent + g for g in stickers(c, (0, 0, 0))]
 
     lines += cubelet_geoms("DBL", "      ")

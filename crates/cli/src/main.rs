@@ -5,6 +5,7 @@ mod bench;
 mod bench_sim;
 mod demo;
 mod net;
+mod render;
 mod solve;
 
 use std::process::ExitCode;
@@ -24,6 +25,7 @@ enum Command {
     Solve(solve::SolveArgs),
     Scramble(solve::ScrambleArgs),
     Demo(demo::DemoArgs),
+    Render(render::RenderArgs),
     /// Prints performance figures.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
         Command::Solve(args) => solve::solve(args),
         Command::Scramble(args) => solve::scramble(args),
         Command::Demo(args) => demo::run(args),
+        Command::Render(args) => render::run(args),
         Command::Bench(command) => bench::run(command),
     };
     match outcome {

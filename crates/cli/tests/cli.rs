@@ -124,3 +124,35 @@ fn demo_solves_its_scramble() {
     assert!(stdout(&o).contains("Optimal plan, 9 quarter turns"));
     assert!(stdout(&o).trim_end().ends_with("Solved."));
 }
+
+#[test]
+fn render_writes_a_picture_and_missing_assets_fail_cleanly() {
+    let out = std::env::temp_dir().join("dexcube-cli-render.png");
+    let o = dexcube(
+        &[
+            "render",
+            "--scene",
+            "cube",
+            "--scramble",
+            "R U",
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = std::fs::read(&out).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+
+    let o = Command::new(env!("CARGO_BIN_EXE_dexcube"))
+        .args(["render", "--out", "/tmp/never.png"])
+        .env("DEXCUBE_ASSETS", "/no/such/assets")
+        .output()
+        .unwrap();
+    assert_clean_failure(&o, 2, "missing model file /no/such/assets/cube/scene.xml");
+    assert!(stderr(&o).contains("scripts/setup"));
+}

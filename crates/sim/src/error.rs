@@ -22,6 +22,10 @@ pub enum SimError {
     },
     /// The simulation produced NaN or infinite values, or MuJoCo flagged an unstable state.
     Diverged { time: f64, what: String },
+    /// Offscreen rendering could not start or run.
+    Render { message: String },
+    /// A picture or video could not be written.
+    Write { path: PathBuf, message: String },
 }
 
 impl fmt::Display for SimError {
@@ -54,6 +58,15 @@ impl fmt::Display for SimError {
                 f,
                 "the simulation diverged at t = {time:.3} s ({what}); reset the environment"
             ),
+            SimError::Render { message } => write!(
+                f,
+                "offscreen rendering failed: {message}; it needs EGL and Mesa's software OpenGL \
+                 (Debian/Ubuntu: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri, which \
+                 scripts/setup does when run as root)"
+            ),
+            SimError::Write { path, message } => {
+                write!(f, "could not write {}: {message}", path.display())
+            }
         }
     }
 }

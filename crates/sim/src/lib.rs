@@ -8,6 +8,7 @@
 
 pub mod cube;
 pub mod error;
+pub mod render;
 pub mod rotation;
 pub mod scene;
 pub mod sim;

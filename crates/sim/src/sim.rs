@@ -14,6 +14,22 @@ use crate::scene::{HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene, SceneKind};
 /// Physics substeps of 0.002 s per control step, as in Gymnasium-Robotics' hand envs.
 pub const SUBSTEPS: usize = 20;
 
+/// MuJoCo's warnings for a state it had to reset, with what each means.
+const BAD_STATE_WARNINGS: [(mjtWarning, &str); 3] = [
+    (
+        mjtWarning::mjWARN_BADQPOS,
+        "a bad joint position (mjWARN_BADQPOS)",
+    ),
+    (
+        mjtWarning::mjWARN_BADQVEL,
+        "a bad joint velocity (mjWARN_BADQVEL)",
+    ),
+    (
+        mjtWarning::mjWARN_BADQACC,
+        "a bad acceleration (mjWARN_BADQACC)",
+    ),
+];
+
 /// A position and orientation in the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pose {
@@ -67,6 +83,7 @@ impl Sim {
     /// One control step: `SUBSTEPS` physics steps. Fails if the state blew up, in which case
     /// the caller should `reset`.
     pub fn step(&mut self) -> Result<(), SimError> {
+        let before = self.bad_state_warnings();
         let detent = matches!(self.scene.kind(), SceneKind::Cube);
         for _ in 0..SUBSTEPS {
             if detent {
@@ -74,7 +91,7 @@ impl Sim {
             }
             self.data.step();
         }
-        self.check_finite()
+        self.check_finite(before)
     }
 
     /// Recomputes positions, contacts and the rest after the state was set by hand.
@@ -82,23 +99,36 @@ impl Sim {
         self.data.forward();
     }
 
-    fn check_finite(&mut self) -> Result<(), SimError> {
-        let unstable = self.data.warning()[mjtWarning::mjWARN_BADQACC as usize].number > 0;
-        let bad_value = !self
+    /// How often MuJoCo has found a bad position, velocity or acceleration (and reset the
+    /// state because of it), by kind.
+    fn bad_state_warnings(&self) -> [i32; 3] {
+        let warnings = self.data.warning();
+        BAD_STATE_WARNINGS.map(|(w, _)| warnings[w as usize].number)
+    }
+
+    fn check_finite(&mut self, before: [i32; 3]) -> Result<(), SimError> {
+        let after = self.bad_state_warnings();
+        if let Some(k) = (0..3).find(|&k| after[k] > before[k]) {
+            let what = format!(
+                "MuJoCo found {} and reset the state",
+                BAD_STATE_WARNINGS[k].1
+            );
+            return Err(SimError::Diverged {
+                time: self.time(),
+                what,
+            });
+        }
+        if !self
             .data
             .qpos()
             .iter()
             .chain(self.data.qvel())
-            .all(|x| x.is_finite());
-        if unstable || bad_value {
-            let what = if unstable {
-                "MuJoCo reported a bad acceleration (mjWARN_BADQACC) and reset the state"
-            } else {
-                "NaN or infinite joint positions or velocities"
-            };
+            .all(|x| x.is_finite())
+        {
+            let what = "NaN or infinite joint positions or velocities".to_string();
             return Err(SimError::Diverged {
                 time: self.time(),
-                what: what.to_string(),
+                what,
             });
         }
         Ok(())
