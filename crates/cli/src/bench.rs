@@ -15,6 +15,8 @@ pub enum BenchCommand {
     Solver(SolverArgs),
     /// Control steps per second of each scene, beside a raw mj_step loop, on 1 and 2 threads.
     Sim(crate::bench_sim::SimArgs),
+    /// Environment steps per second on 1, 2 and all threads, beside the bare simulator.
+    Env(crate::bench_env::EnvArgs),
 }
 
 #[derive(Args)]
@@ -37,6 +39,7 @@ pub fn run(command: BenchCommand) -> anyhow::Result<ExitCode> {
     match command {
         BenchCommand::Solver(args) => solver(args),
         BenchCommand::Sim(args) => crate::bench_sim::run(args),
+        BenchCommand::Env(args) => crate::bench_env::run(args),
     }
 }
 

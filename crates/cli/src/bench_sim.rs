@@ -51,13 +51,13 @@ struct SimReport {
 }
 
 /// Episode length in control steps, as the environments use.
-const EPISODE: usize = 100;
+pub const EPISODE: usize = dexcube_env::EPISODE_STEPS;
 
 /// Interleaved timing rounds of the raw loop and the wrapper.
 const ROUNDS: usize = 3;
 
 /// Random actions for `steps` control steps, the same for every run.
-fn actions(steps: usize, seed: u64) -> Vec<[f64; HAND_ACTUATORS]> {
+pub fn actions(steps: usize, seed: u64) -> Vec<[f64; HAND_ACTUATORS]> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     (0..steps)
         .map(|_| std::array::from_fn(|_| rng.random_range(-1.0..=1.0)))
@@ -65,7 +65,7 @@ fn actions(steps: usize, seed: u64) -> Vec<[f64; HAND_ACTUATORS]> {
 }
 
 /// Steps per second through the `Sim` wrapper, and contacts per step.
-fn through_sim(scene: &Arc<Scene>, actions: &[[f64; HAND_ACTUATORS]]) -> (f64, f64) {
+pub fn through_sim(scene: &Arc<Scene>, actions: &[[f64; HAND_ACTUATORS]]) -> (f64, f64) {
     let mut sim = Sim::new(scene.clone());
     let mut contacts = 0;
     let start = Instant::now();
@@ -108,7 +108,7 @@ fn raw_loop(scene: &Arc<Scene>, actions: &[[f64; HAND_ACTUATORS]]) -> f64 {
 
 /// How much faster two threads run a pure arithmetic loop than one: the most a CPU-bound
 /// program can scale on this machine right now (vCPUs may share physical cores).
-fn machine_scaling() -> f64 {
+pub fn machine_scaling() -> f64 {
     fn spin() -> f64 {
         let mut x = 1.0f64;
         for i in 0..60_000_000u64 {

@@ -2,8 +2,10 @@
 //! lives in its own module; errors print one clear line to stderr and exit with status 2.
 
 mod bench;
+mod bench_env;
 mod bench_sim;
 mod demo;
+mod env;
 mod net;
 mod render;
 mod solve;
@@ -26,6 +28,9 @@ enum Command {
     Scramble(solve::ScrambleArgs),
     Demo(demo::DemoArgs),
     Render(render::RenderArgs),
+    /// Inspects the training environments.
+    #[command(subcommand)]
+    Env(env::EnvCommand),
     /// Prints performance figures.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -38,6 +43,7 @@ fn main() -> ExitCode {
         Command::Scramble(args) => solve::scramble(args),
         Command::Demo(args) => demo::run(args),
         Command::Render(args) => render::run(args),
+        Command::Env(command) => env::run(command),
         Command::Bench(command) => bench::run(command),
     };
     match outcome {

@@ -40,12 +40,19 @@ pub struct Pose {
 pub struct Sim {
     scene: Arc<Scene>,
     data: MjData<Arc<MjModel>>,
+    control_steps: u64,
+    physics_time: std::time::Duration,
 }
 
 impl Sim {
     pub fn new(scene: Arc<Scene>) -> Sim {
         let data = MjData::new(scene.model().clone());
-        let mut sim = Sim { scene, data };
+        let mut sim = Sim {
+            scene,
+            data,
+            control_steps: 0,
+            physics_time: std::time::Duration::ZERO,
+        };
         sim.reset();
         sim
     }
@@ -69,6 +76,17 @@ impl Sim {
         self.data.forward();
     }
 
+    /// Control steps run since this simulation was made, resets and all.
+    pub fn control_steps(&self) -> u64 {
+        self.control_steps
+    }
+
+    /// Wall time spent inside `step` since this simulation was made: what a caller's own
+    /// overhead is measured against.
+    pub fn physics_time(&self) -> std::time::Duration {
+        self.physics_time
+    }
+
     /// Simulated time in seconds.
     pub fn time(&self) -> f64 {
         self.data.ffi().time
@@ -83,7 +101,9 @@ impl Sim {
     /// One control step: `SUBSTEPS` physics steps. Fails if the state blew up, in which case
     /// the caller should `reset`.
     pub fn step(&mut self) -> Result<(), SimError> {
+        let start = std::time::Instant::now();
         let before = self.bad_state_warnings();
+        self.control_steps += 1;
         let detent = matches!(self.scene.kind(), SceneKind::Cube);
         for _ in 0..SUBSTEPS {
             if detent {
@@ -91,7 +111,9 @@ impl Sim {
             }
             self.data.step();
         }
-        self.check_finite(before)
+        let checked = self.check_finite(before);
+        self.physics_time += start.elapsed();
+        checked
     }
 
     /// Recomputes positions, contacts and the rest after the state was set by hand.

@@ -1,0 +1,160 @@
+//! `dexcube env`: look at the training environments from the command line, their spaces and
+//! random-policy rollouts.
+
+use std::process::ExitCode;
+
+use clap::{Args, Subcommand, ValueEnum};
+use dexcube_env::layer::LayerGoals;
+use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotMode};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+#[derive(Subcommand)]
+pub enum EnvCommand {
+    /// Prints an environment's observation, goal and action sizes and its success test.
+    Info(EnvChoice),
+    /// Runs episodes with a policy and prints success and return per episode.
+    Rollout(RolloutArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum EnvKind {
+    /// CubeRotEnv, Stage 1.
+    Rot,
+    /// LayerOpEnv, Stage 2.
+    Layer,
+}
+
+#[derive(Args)]
+pub struct EnvChoice {
+    #[arg(value_enum)]
+    env: EnvKind,
+    /// CubeRotEnv's success test: paper (whole orientation) or axis (the up axis only).
+    #[arg(long, default_value = "paper")]
+    mode: RotMode,
+    /// LayerOpEnv's move: U U' R R' F F'.
+    #[arg(long = "move", default_value = "U'")]
+    layer_move: LayerMove,
+}
+
+impl EnvChoice {
+    /// Builds the chosen environment; LayerOpEnv samples training goals.
+    pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
+        Ok(match self.env {
+            EnvKind::Rot => Box::new(CubeRotEnv::new(self.mode)?),
+            EnvKind::Layer => Box::new(LayerOpEnv::new(self.layer_move, LayerGoals::Training)?),
+        })
+    }
+
+    fn name(&self) -> String {
+        match self.env {
+            EnvKind::Rot => format!("CubeRotEnv ({} mode)", self.mode.name()),
+            EnvKind::Layer => format!("LayerOpEnv ({})", self.layer_move.name()),
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum PolicyArg {
+    /// Uniform random actions in [-1, 1]^20.
+    Random,
+    /// The neutral action (every actuator at the middle of its range).
+    Zero,
+}
+
+#[derive(Args)]
+pub struct RolloutArgs {
+    #[command(flatten)]
+    choice: EnvChoice,
+    #[arg(long, value_enum, default_value = "random")]
+    policy: PolicyArg,
+    #[arg(long, default_value_t = 10)]
+    episodes: u64,
+    /// Episode i is reset with seed + i; the random policy draws from seed too.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+pub fn run(command: EnvCommand) -> anyhow::Result<ExitCode> {
+    match command {
+        EnvCommand::Info(choice) => info(&choice),
+        EnvCommand::Rollout(args) => rollout(&args),
+    }
+}
+
+fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
+    let env = choice.build()?;
+    let spaces = env.spaces();
+    println!("{}", choice.name());
+    println!("  observation: {} floats", spaces.observation);
+    println!(
+        "  goal:        {} floats (achieved_goal and desired_goal)",
+        spaces.goal
+    );
+    println!(
+        "  action:      {} floats in [-1, 1], absolute joint targets",
+        spaces.action
+    );
+    println!(
+        "  episode:     {} control steps of 20 x 0.002 s",
+        dexcube_env::EPISODE_STEPS
+    );
+    match choice.env {
+        EnvKind::Rot => println!(
+            "  success:     position within 0.01 m and {} within 0.1 rad; reward 0, else -1",
+            if choice.mode == RotMode::Paper {
+                "orientation"
+            } else {
+                "the up axis"
+            }
+        ),
+        EnvKind::Layer => {
+            println!("  success:     layer angle within 0.1 rad of the goal; reward 0, else -1")
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn rollout(args: &RolloutArgs) -> anyhow::Result<ExitCode> {
+    let mut env = args.choice.build()?;
+    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let mut successes = 0;
+    println!(
+        "{} with the {} policy, seed {}",
+        args.choice.name(),
+        policy_name(args.policy),
+        args.seed
+    );
+    println!("episode  steps  return  success  final angle error (rad)");
+    for episode in 0..args.episodes {
+        env.reset(Some(args.seed.wrapping_add(episode)));
+        let (mut total, mut steps) = (0.0, 0);
+        let last = loop {
+            let action: Vec<f64> = match args.policy {
+                PolicyArg::Random => (0..20).map(|_| rng.random_range(-1.0..=1.0)).collect(),
+                PolicyArg::Zero => vec![0.0; 20],
+            };
+            let t = env.step(&action);
+            total += t.reward;
+            steps += 1;
+            if t.terminated || t.truncated {
+                break t;
+            }
+        };
+        successes += last.info.is_success as usize;
+        let end = if last.info.dropped { " (dropped)" } else { "" };
+        println!(
+            "{episode:>7}  {steps:>5}  {total:>6.0}  {:>7}  {:.3}{end}",
+            last.info.is_success, last.info.angle_error
+        );
+    }
+    println!("success rate: {successes}/{}", args.episodes);
+    Ok(ExitCode::SUCCESS)
+}
+
+fn policy_name(policy: PolicyArg) -> &'static str {
+    match policy {
+        PolicyArg::Random => "random",
+        PolicyArg::Zero => "zero",
+    }
+}

@@ -1,0 +1,194 @@
+//! What CubeRotEnv and LayerOpEnv share: the hand with an object on its palm, the first 61
+//! observations, placing the object at reset, the drop test, and turning a goal's verdict
+//! into a `Transition`.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use dexcube_sim::rotation::{self, Quat};
+use dexcube_sim::{HAND_ACTUATORS, Pose, Scene, Sim};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::goal::Goal;
+use crate::{EPISODE_STEPS, Info, Observation, Transition};
+
+/// Observations shared by both environments: joint angles 24, joint velocities 24, object
+/// position 3, orientation 4, velocity 3, angular velocity 3.
+pub const BASE_OBSERVATION: usize = 61;
+
+/// How far below its resting point the object must fall to count as dropped, metres.
+pub const DROP_DEPTH: f64 = 0.05;
+
+/// Control steps with a neutral action that let a newly placed object settle, as
+/// Gymnasium-Robotics does.
+const SETTLE_STEPS: usize = 10;
+
+/// Standard deviation of the object's start position around its resting point, metres
+/// (Gymnasium-Robotics' 0.005).
+const START_POSITION_NOISE: f64 = 0.005;
+
+pub struct HandObject {
+    pub sim: Sim,
+    pub rng: ChaCha8Rng,
+    /// Where the object comes to rest on the palm, and CubeRotEnv's target position.
+    pub resting: [f64; 3],
+    pub steps: usize,
+}
+
+impl HandObject {
+    /// A hand with its object, and the object's resting point: where it settles from the
+    /// scene's start with a neutral action.
+    pub fn new(scene: Arc<Scene>) -> HandObject {
+        let mut sim = Sim::new(scene);
+        let start = sim.object_pose();
+        settle(&mut sim);
+        let resting = if sim.object_pose().position[2] > start.position[2] - DROP_DEPTH {
+            sim.object_pose().position
+        } else {
+            start.position
+        };
+        HandObject {
+            sim,
+            rng: ChaCha8Rng::seed_from_u64(0),
+            resting,
+            steps: 0,
+        }
+    }
+
+    /// Re-seeds the generator if asked.
+    pub fn seed(&mut self, seed: Option<u64>) {
+        if let Some(seed) = seed {
+            self.rng = ChaCha8Rng::seed_from_u64(seed);
+        }
+    }
+
+    /// Resets the hand and puts the object on the palm with `orientation`, near the resting
+    /// point, then lets it settle. Tries again, up to ten times, if it rolls off.
+    pub fn place(&mut self, orientation: impl Fn(&mut ChaCha8Rng) -> Quat) {
+        for _ in 0..10 {
+            self.sim.reset();
+            let mut position = self.resting;
+            for p in &mut position {
+                *p += START_POSITION_NOISE * normal(&mut self.rng);
+            }
+            let orientation = orientation(&mut self.rng);
+            self.sim.set_object_pose(&Pose {
+                position,
+                orientation,
+            });
+            self.sim.forward();
+            if settle(&mut self.sim) && !self.dropped() {
+                break;
+            }
+        }
+        self.steps = 0;
+    }
+
+    pub fn dropped(&self) -> bool {
+        self.sim.object_pose().position[2] < self.resting[2] - DROP_DEPTH
+    }
+
+    /// The 61 shared observations; the orientation is given with w ≥ 0.
+    pub fn base_observation(&self) -> Vec<f64> {
+        let pose = self.sim.object_pose();
+        let (velocity, angular) = self.sim.object_velocity();
+        let mut out = Vec::with_capacity(BASE_OBSERVATION + 1);
+        out.extend(self.sim.hand_angles());
+        out.extend(self.sim.hand_velocities());
+        out.extend(pose.position);
+        out.extend(canonical(pose.orientation));
+        out.extend(velocity);
+        out.extend(angular);
+        out
+    }
+
+    /// One control step; returns a physics error if the state blew up (the simulation is then
+    /// reset, and the episode must end).
+    fn advance(&mut self, action: &[f64]) -> Option<dexcube_sim::SimError> {
+        let mut clipped = [0.0; HAND_ACTUATORS];
+        for (c, a) in clipped.iter_mut().zip(action) {
+            *c = if a.is_finite() {
+                a.clamp(-1.0, 1.0)
+            } else {
+                0.0
+            };
+        }
+        self.sim.set_action(&clipped);
+        self.steps += 1;
+        self.sim.step().err().inspect(|_| self.sim.reset())
+    }
+
+    /// One environment step: the action for a control step, then the observation `observe`
+    /// makes and the goal's verdict on it.
+    pub fn step(
+        &mut self,
+        action: &[f64],
+        goal: &dyn Goal,
+        observe: impl FnOnce(&HandObject) -> Observation,
+    ) -> Transition {
+        let error = self.advance(action);
+        self.transition(observe(self), goal, error)
+    }
+
+    /// A transition from an observation and the goal's verdict on it.
+    fn transition(
+        &self,
+        observation: Observation,
+        goal: &dyn Goal,
+        physics_error: Option<dexcube_sim::SimError>,
+    ) -> Transition {
+        let info = self.info(&observation, goal, physics_error);
+        let reward = goal.compute_reward(&observation.achieved_goal, &observation.desired_goal);
+        Transition {
+            terminated: info.dropped || info.physics_error.is_some(),
+            truncated: self.steps >= EPISODE_STEPS,
+            observation,
+            reward,
+            info,
+        }
+    }
+
+    pub fn info(
+        &self,
+        observation: &Observation,
+        goal: &dyn Goal,
+        physics_error: Option<dexcube_sim::SimError>,
+    ) -> Info {
+        let (achieved, desired) = (&observation.achieved_goal, &observation.desired_goal);
+        let (position_error, angle_error) = goal.errors(achieved, desired);
+        Info {
+            is_success: goal.is_success(achieved, desired),
+            position_error,
+            angle_error,
+            dropped: self.dropped(),
+            physics_error,
+        }
+    }
+}
+
+/// Lets the object settle with a neutral action; false if the physics blew up.
+fn settle(sim: &mut Sim) -> bool {
+    sim.set_action(&[0.0; HAND_ACTUATORS]);
+    (0..SETTLE_STEPS).all(|_| sim.step().is_ok())
+}
+
+/// The same rotation with a non-negative real part.
+pub fn canonical(q: Quat) -> Quat {
+    if q[0] < 0.0 { q.map(|x| -x) } else { q }
+}
+
+/// A standard normal draw (Box–Muller).
+fn normal(rng: &mut impl Rng) -> f64 {
+    let u1: f64 = 1.0 - rng.random::<f64>();
+    let u2: f64 = rng.random();
+    (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
+}
+
+/// A rotation drawn uniformly from SO(3) (Shoemake's method).
+pub fn uniform_rotation(rng: &mut impl Rng) -> Quat {
+    let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let (t2, t3) = (2.0 * PI * u2, 2.0 * PI * u3);
+    rotation::normalise(&[b * t3.cos(), a * t2.sin(), a * t2.cos(), b * t3.sin()])
+}

@@ -1,0 +1,91 @@
+//! # dexcube-env
+//!
+//! The paper's two training environments in Gymnasium-Robotics' goal-env shape: an observation
+//! in three parts (`observation`, `achieved_goal`, `desired_goal`), a sparse reward of 0 on
+//! success and -1 otherwise computed by pure functions of the goals (so Hindsight Experience
+//! Replay can relabel), and `terminated` / `truncated` as in Gymnasium.
+//!
+//! - [`CubeRotEnv`] (Stage 1): re-pose a rigid 5 cm cube on the palm; observation 61, goal 7.
+//! - [`LayerOpEnv`] (Stage 2): turn one layer of a two-layer block; observation 62, goal 1.
+//! - [`VecEnv`]: many environments stepped on a thread pool, each with its own `MjData`.
+//!
+//! Dynamics follow Gymnasium-Robotics' hand environments: an action in [-1, 1]^20 maps onto
+//! the actuators' control ranges as absolute joint targets, a control step is 20 substeps of
+//! 0.002 s, an episode is 100 control steps, and the hand starts at its model pose.
+
+pub mod goal;
+mod hand_object;
+pub mod layer;
+pub mod rot;
+pub mod vec_env;
+
+use std::sync::Arc;
+
+pub use dexcube_sim::SimError;
+pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
+pub use layer::{LayerMove, LayerOpEnv};
+pub use rot::CubeRotEnv;
+pub use vec_env::VecEnv;
+
+/// Control steps in an episode (the paper's 100).
+pub const EPISODE_STEPS: usize = 100;
+
+/// An observation in Gymnasium-Robotics' three parts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Observation {
+    pub observation: Vec<f64>,
+    pub achieved_goal: Vec<f64>,
+    pub desired_goal: Vec<f64>,
+}
+
+/// What `step` and `reset` report besides the observation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Info {
+    pub is_success: bool,
+    /// Distance from the goal position, metres (0 where the goal has no position).
+    pub position_error: f64,
+    /// Angle from the goal orientation or layer angle, radians.
+    pub angle_error: f64,
+    /// The object fell below the palm.
+    pub dropped: bool,
+    /// The physics blew up during this step; the environment must be reset.
+    pub physics_error: Option<SimError>,
+}
+
+/// One step's outcome.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transition {
+    pub observation: Observation,
+    pub reward: f64,
+    /// The episode ended in failure: the object dropped or the physics blew up.
+    pub terminated: bool,
+    /// The episode reached its step limit.
+    pub truncated: bool,
+    pub info: Info,
+}
+
+/// Sizes of the spaces, for building networks from an environment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Spaces {
+    pub observation: usize,
+    pub goal: usize,
+    pub action: usize,
+}
+
+/// Gymnasium-Robotics' goal-conditioned environment contract.
+pub trait GoalEnv: Send {
+    fn spaces(&self) -> Spaces;
+
+    /// The success test and reward, shareable with a replay buffer.
+    fn goal(&self) -> Arc<dyn Goal>;
+
+    /// Starts an episode. A seed re-seeds the environment's generator; `None` continues it.
+    fn reset(&mut self, seed: Option<u64>) -> (Observation, Info);
+
+    /// Applies an action in [-1, 1]^20 for one control step.
+    fn step(&mut self, action: &[f64]) -> Transition;
+
+    /// The simulation, for rendering and inspection.
+    fn sim(&self) -> &dexcube_sim::Sim;
+    fn sim_mut(&mut self) -> &mut dexcube_sim::Sim;
+}

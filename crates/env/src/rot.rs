@@ -1,0 +1,178 @@
+//! CubeRotEnv (Stage 1): re-pose a rigid 5 cm cube on the palm so that a given face is up.
+//!
+//! Observation (61): hand joint angles 24, joint velocities 24, cube position 3, orientation
+//! quaternion 4 (w first, w ≥ 0), linear velocity 3, angular velocity 3. Goal (7): target
+//! position and quaternion.
+//!
+//! What is sampled, exactly: at reset the cube is placed at its resting point on the palm
+//! plus N(0, 5 mm) noise on each coordinate, with an orientation drawn uniformly from SO(3)
+//! (the paper's "arbitrary orientation"), and left to settle for 10 neutral control steps.
+//! The goal is one of the paper's three target orientations, each with probability 1/3, at
+//! the resting point. In the cube frame (x = R, y = B, z = U) those targets put U, R and B
+//! on top. The paper names the third the F pose: with F facing -y, a +90° turn about x lifts
+//! B, and turning B on top with U' is B', the same move as F up to a whole-cube turn.
+
+use std::sync::Arc;
+
+use dexcube_sim::rotation::Quat;
+use dexcube_sim::{Scene, SceneKind, SimError};
+use rand::Rng;
+
+use crate::goal::{Goal, RotGoal, RotMode};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical, uniform_rotation};
+use crate::{GoalEnv, Info, Observation, Spaces, Transition};
+
+/// The paper's three Stage 1 targets, `[w, x, y, z]`.
+pub const PAPER_TARGETS: [Quat; 3] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [
+        std::f64::consts::FRAC_1_SQRT_2,
+        0.0,
+        -std::f64::consts::FRAC_1_SQRT_2,
+        0.0,
+    ],
+    [
+        std::f64::consts::FRAC_1_SQRT_2,
+        std::f64::consts::FRAC_1_SQRT_2,
+        0.0,
+        0.0,
+    ],
+];
+
+pub struct CubeRotEnv {
+    hand: HandObject,
+    goal: Arc<RotGoal>,
+    desired: Vec<f64>,
+}
+
+impl CubeRotEnv {
+    /// A CubeRotEnv with the paper's thresholds in the given mode.
+    pub fn new(mode: RotMode) -> Result<CubeRotEnv, SimError> {
+        Ok(CubeRotEnv::with_scene(
+            Scene::load(SceneKind::Rot)?,
+            RotGoal::paper(mode),
+        ))
+    }
+
+    /// A CubeRotEnv over an already loaded `rot` scene (shared between environments).
+    pub fn with_scene(scene: Arc<Scene>, goal: RotGoal) -> CubeRotEnv {
+        let hand = HandObject::new(scene);
+        let desired = target(hand.resting, PAPER_TARGETS[0]);
+        CubeRotEnv {
+            hand,
+            goal: Arc::new(goal),
+            desired,
+        }
+    }
+
+    /// Sets the goal (position, then quaternion) for the episode under way.
+    pub fn set_desired_goal(&mut self, desired: &[f64]) {
+        self.desired = desired.to_vec();
+        self.show_target();
+    }
+
+    /// The palm's resting point, the target position.
+    pub fn resting_point(&self) -> [f64; 3] {
+        self.hand.resting
+    }
+
+    fn observe(&self) -> Observation {
+        let observation = self.hand.base_observation();
+        let achieved_goal = observation[48..55].to_vec();
+        Observation {
+            observation,
+            achieved_goal,
+            desired_goal: self.desired.clone(),
+        }
+    }
+
+    /// Turns the ghost cube beside the hand to the goal orientation.
+    fn show_target(&mut self) {
+        if let dexcube_sim::scene::ObjectJoints::Rot { target_mocap, .. } =
+            self.hand.sim.scene().object()
+        {
+            let mocap = *target_mocap;
+            self.hand.sim.data_mut().mocap_quat_mut()[mocap].copy_from_slice(&self.desired[3..7]);
+        }
+    }
+}
+
+/// The 61 observations, with the cube's pose (observations 48 to 54) as the achieved goal.
+fn observe(hand: &HandObject, desired: &[f64]) -> Observation {
+    let observation = hand.base_observation();
+    let achieved_goal = observation[48..55].to_vec();
+    Observation {
+        observation,
+        achieved_goal,
+        desired_goal: desired.to_vec(),
+    }
+}
+
+fn target(position: [f64; 3], orientation: Quat) -> Vec<f64> {
+    position
+        .iter()
+        .chain(canonical(orientation).iter())
+        .copied()
+        .collect()
+}
+
+impl GoalEnv for CubeRotEnv {
+    fn spaces(&self) -> Spaces {
+        Spaces {
+            observation: BASE_OBSERVATION,
+            goal: 7,
+            action: dexcube_sim::HAND_ACTUATORS,
+        }
+    }
+
+    fn goal(&self) -> Arc<dyn Goal> {
+        self.goal.clone()
+    }
+
+    fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
+        self.hand.seed(seed);
+        self.hand.place(uniform_rotation);
+        let pick = self.hand.rng.random_range(0..PAPER_TARGETS.len());
+        self.desired = target(self.hand.resting, PAPER_TARGETS[pick]);
+        self.show_target();
+        let observation = self.observe();
+        let info = self.hand.info(&observation, self.goal.as_ref(), None);
+        (observation, info)
+    }
+
+    fn step(&mut self, action: &[f64]) -> Transition {
+        let desired = &self.desired;
+        self.hand
+            .step(action, self.goal.as_ref(), |hand| observe(hand, desired))
+    }
+
+    fn sim(&self) -> &dexcube_sim::Sim {
+        &self.hand.sim
+    }
+
+    fn sim_mut(&mut self) -> &mut dexcube_sim::Sim {
+        &mut self.hand.sim
+    }
+}
+
+impl RotMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            RotMode::Paper => "paper",
+            RotMode::Axis => "axis",
+        }
+    }
+}
+
+impl std::str::FromStr for RotMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "paper" => Ok(RotMode::Paper),
+            "axis" => Ok(RotMode::Axis),
+            other => Err(format!(
+                "unknown CubeRotEnv mode '{other}': use paper or axis"
+            )),
+        }
+    }
+}

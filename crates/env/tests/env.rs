@@ -1,0 +1,231 @@
+//! The goal-env contract of CubeRotEnv and LayerOpEnv, with real physics.
+
+use dexcube_env::layer::LayerGoals;
+use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotMode, VecEnv};
+use dexcube_sim::Pose;
+use dexcube_sim::rotation::{self, about};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn random_action(rng: &mut ChaCha8Rng) -> Vec<f64> {
+    (0..20).map(|_| rng.random_range(-1.0..=1.0)).collect()
+}
+
+#[test]
+fn spaces_have_the_papers_sizes() {
+    let rot = CubeRotEnv::new(RotMode::Paper).unwrap();
+    assert_eq!(
+        (
+            rot.spaces().observation,
+            rot.spaces().goal,
+            rot.spaces().action
+        ),
+        (61, 7, 20)
+    );
+    let mut layer = LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Training).unwrap();
+    assert_eq!((layer.spaces().observation, layer.spaces().goal), (62, 1));
+    let (obs, _) = layer.reset(Some(1));
+    assert_eq!(
+        (
+            obs.observation.len(),
+            obs.achieved_goal.len(),
+            obs.desired_goal.len()
+        ),
+        (62, 1, 1)
+    );
+}
+
+/// Steps `env` with random actions for `episodes` episodes and checks every reward against
+/// the pure functions, also on goals relabelled to achieved ones (HER's view).
+fn rewards_agree(env: &mut dyn GoalEnv, episodes: u64) -> usize {
+    let goal = env.goal();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let mut checked = 0;
+    for episode in 0..episodes {
+        env.reset(Some(episode));
+        let mut achieved_before = None;
+        for _ in 0..dexcube_env::EPISODE_STEPS {
+            let t = env.step(&random_action(&mut rng));
+            let (a, d) = (&t.observation.achieved_goal, &t.observation.desired_goal);
+            assert_eq!(t.reward, goal.compute_reward(a, d));
+            assert_eq!(t.info.is_success, goal.is_success(a, d));
+            assert_eq!(t.reward == 0.0, t.info.is_success);
+            assert_eq!(
+                goal.compute_reward(a, a),
+                0.0,
+                "an achieved goal is a success"
+            );
+            if let Some(before) = achieved_before.replace(a.clone()) {
+                let r = goal.compute_reward(a, &before);
+                assert!(r == 0.0 || r == -1.0);
+            }
+            checked += 1;
+            if t.terminated || t.truncated {
+                break;
+            }
+        }
+    }
+    checked
+}
+
+#[test]
+fn compute_reward_agrees_with_step_on_thousands_of_transitions() {
+    let mut rot = CubeRotEnv::new(RotMode::Paper).unwrap();
+    let mut layer = LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Training).unwrap();
+    let checked = rewards_agree(&mut rot, 12) + rewards_agree(&mut layer, 12);
+    assert!(checked > 1000, "{checked}");
+}
+
+#[test]
+fn rot_success_is_detected_just_inside_and_not_just_outside_the_thresholds() {
+    for mode in [RotMode::Paper, RotMode::Axis] {
+        let mut env = CubeRotEnv::new(mode).unwrap();
+        env.reset(Some(3));
+        let target_q = rotation::about([0.0, 1.0, 0.0], -std::f64::consts::FRAC_PI_2);
+        let rest = env.resting_point();
+        let desired: Vec<f64> = rest.iter().chain(target_q.iter()).copied().collect();
+        env.set_desired_goal(&desired);
+        let goal = env.goal();
+        let judge = |position: [f64; 3], orientation: [f64; 4], env: &mut CubeRotEnv| {
+            env.sim_mut().set_object_pose(&Pose {
+                position,
+                orientation,
+            });
+            env.sim_mut().forward();
+            let obs = env.sim().object_pose();
+            let achieved: Vec<f64> = obs
+                .position
+                .iter()
+                .chain(obs.orientation.iter())
+                .copied()
+                .collect();
+            goal.is_success(&achieved, &desired)
+        };
+        let shifted = |d: f64| [rest[0] + d, rest[1], rest[2]];
+        let tilted = |a: f64| rotation::mul(&about([1.0, 0.0, 0.0], a), &target_q);
+        assert!(
+            judge(rest, target_q, &mut env),
+            "{mode:?}: exactly at the goal"
+        );
+        assert!(
+            judge(shifted(0.009), tilted(0.09), &mut env),
+            "{mode:?}: just inside"
+        );
+        assert!(
+            !judge(shifted(0.011), target_q, &mut env),
+            "{mode:?}: 11 mm off"
+        );
+        assert!(
+            !judge(rest, tilted(0.11), &mut env),
+            "{mode:?}: tilted 0.11 rad"
+        );
+        let yawed = rotation::mul(&about([0.0, 0.0, 1.0], 1.0), &target_q);
+        assert_eq!(
+            judge(rest, yawed, &mut env),
+            mode == RotMode::Axis,
+            "{mode:?}: turned about the vertical"
+        );
+    }
+}
+
+#[test]
+fn layer_success_is_detected_within_a_tenth_of_a_radian() {
+    let mut env = LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
+    let (obs, _) = env.reset(Some(5));
+    assert_eq!(obs.desired_goal, [std::f64::consts::FRAC_PI_2]);
+    for (offset, success) in [
+        (0.0, true),
+        (0.09, true),
+        (-0.09, true),
+        (0.11, false),
+        (-0.11, false),
+    ] {
+        env.set_layer_angle(std::f64::consts::FRAC_PI_2 + offset);
+        let t = env.step(&[0.0; 20]);
+        let (a, d) = (&t.observation.achieved_goal, &t.observation.desired_goal);
+        // One step of physics moves the layer a little: judge what was achieved.
+        assert_eq!(env.goal().is_success(a, d), (a[0] - d[0]).abs() < 0.1);
+        let exact = env
+            .goal()
+            .is_success(&[std::f64::consts::FRAC_PI_2 + offset], d);
+        assert_eq!(exact, success, "offset {offset}");
+    }
+    assert_eq!(
+        LayerMove::U.direction(),
+        -1.0,
+        "U is clockwise: a negative angle"
+    );
+}
+
+#[test]
+fn same_seed_same_trajectory_on_any_number_of_threads() {
+    let run = |threads: usize| {
+        let envs = (0..3)
+            .map(|_| CubeRotEnv::new(RotMode::Paper).unwrap())
+            .collect();
+        let mut vec_env = VecEnv::new(envs, threads);
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let mut trace = vec![];
+        for (obs, _) in vec_env.reset(42) {
+            trace.extend(obs.observation);
+        }
+        for _ in 0..30 {
+            let actions: Vec<Vec<f64>> = (0..3).map(|_| random_action(&mut rng)).collect();
+            for step in vec_env.step(&actions) {
+                trace.extend(step.transition.observation.observation);
+            }
+        }
+        trace
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(1));
+}
+
+#[test]
+fn a_dropped_cube_ends_the_episode_as_a_failure() {
+    let mut env = CubeRotEnv::new(RotMode::Paper).unwrap();
+    env.reset(Some(0));
+    let rest = env.resting_point();
+    env.sim_mut().set_object_pose(&Pose {
+        position: [rest[0] + 0.3, rest[1], rest[2]],
+        orientation: rotation::IDENTITY,
+    });
+    let mut ended = false;
+    for _ in 0..20 {
+        let t = env.step(&[0.0; 20]);
+        if t.terminated {
+            assert!(t.info.dropped && !t.info.is_success && t.reward == -1.0);
+            ended = true;
+            break;
+        }
+    }
+    assert!(ended, "a cube that falls off the hand ends the episode");
+}
+
+#[test]
+fn a_blown_up_simulation_resets_that_env_only() {
+    let envs = (0..2)
+        .map(|_| LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Training).unwrap())
+        .collect();
+    let mut vec_env = VecEnv::new(envs, 2);
+    vec_env.reset(7);
+    let dof = vec_env.envs()[0].sim().scene().object().free().dof;
+    vec_env.envs_mut()[0].sim_mut().data_mut().qvel_mut()[dof] = f64::NAN;
+    let steps = vec_env.step(&[vec![0.0; 20], vec![0.0; 20]]);
+    assert!(steps[0].transition.terminated && steps[0].transition.info.physics_error.is_some());
+    assert!(
+        steps[0].reset.is_some(),
+        "the broken env starts a new episode"
+    );
+    assert!(
+        !steps[1].transition.terminated && steps[1].reset.is_none(),
+        "its neighbour goes on"
+    );
+    let again = vec_env.step(&[vec![0.0; 20], vec![0.0; 20]]);
+    assert!(
+        again
+            .iter()
+            .all(|s| s.transition.info.physics_error.is_none())
+    );
+}
