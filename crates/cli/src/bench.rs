@@ -17,6 +17,9 @@ pub enum BenchCommand {
     Sim(crate::bench_sim::SimArgs),
     /// Environment steps per second on 1, 2 and all threads, beside the bare simulator.
     Env(crate::bench_env::EnvArgs),
+    /// The learner: time per optimisation batch and per inference, and the balance of a
+    /// short training run.
+    Rl(crate::bench_rl::RlArgs),
 }
 
 #[derive(Args)]
@@ -40,6 +43,7 @@ pub fn run(command: BenchCommand) -> anyhow::Result<ExitCode> {
         BenchCommand::Solver(args) => solver(args),
         BenchCommand::Sim(args) => crate::bench_sim::run(args),
         BenchCommand::Env(args) => crate::bench_env::run(args),
+        BenchCommand::Rl(args) => crate::bench_rl::run(args),
     }
 }
 

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use clap::Args;
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotGoal, RotMode, VecEnv};
+use dexcube_env::{CubeRotEnv, LayerMove, LayerOpEnv, RotGoal, RotMode, SimulatedEnv, VecEnv};
 use dexcube_sim::{Scene, SceneKind};
 use serde::Serialize;
 
@@ -41,7 +41,7 @@ struct EnvSpeed {
 /// Environment steps per second of `threads` environments on `threads` threads, the physics
 /// control steps run per environment step, and the time outside the physics over the time in
 /// it (for one thread, the environments' overhead).
-fn vec_env_rate<E: GoalEnv>(
+fn vec_env_rate<E: SimulatedEnv>(
     make: impl Fn() -> E,
     threads: usize,
     steps: usize,
@@ -80,7 +80,7 @@ fn vec_env_rate<E: GoalEnv>(
     )
 }
 
-fn measure<E: GoalEnv>(
+fn measure<E: SimulatedEnv>(
     name: &'static str,
     kind: SceneKind,
     make: impl Fn() -> E,

@@ -28,13 +28,13 @@ pub enum EnvKind {
 #[derive(Args)]
 pub struct EnvChoice {
     #[arg(value_enum)]
-    env: EnvKind,
+    pub env: EnvKind,
     /// CubeRotEnv's success test: paper (whole orientation) or axis (the up axis only).
     #[arg(long, default_value = "paper")]
-    mode: RotMode,
+    pub mode: RotMode,
     /// LayerOpEnv's move: U U' R R' F F'.
     #[arg(long = "move", default_value = "U'")]
-    layer_move: LayerMove,
+    pub layer_move: LayerMove,
 }
 
 impl EnvChoice {
@@ -46,7 +46,7 @@ impl EnvChoice {
         })
     }
 
-    fn name(&self) -> String {
+    pub fn name(&self) -> String {
         match self.env {
             EnvKind::Rot => format!("CubeRotEnv ({} mode)", self.mode.name()),
             EnvKind::Layer => format!("LayerOpEnv ({})", self.layer_move.name()),

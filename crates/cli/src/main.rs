@@ -3,12 +3,14 @@
 
 mod bench;
 mod bench_env;
+mod bench_rl;
 mod bench_sim;
 mod demo;
 mod env;
 mod net;
 mod render;
 mod solve;
+mod train;
 
 use std::process::ExitCode;
 
@@ -28,6 +30,7 @@ enum Command {
     Scramble(solve::ScrambleArgs),
     Demo(demo::DemoArgs),
     Render(render::RenderArgs),
+    Train(train::TrainArgs),
     /// Inspects the training environments.
     #[command(subcommand)]
     Env(env::EnvCommand),
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => demo::run(args),
         Command::Render(args) => render::run(args),
         Command::Env(command) => env::run(command),
+        Command::Train(args) => train::run(args),
         Command::Bench(command) => bench::run(command),
     };
     match outcome {

@@ -2,15 +2,15 @@
 //! observations, placing the object at reset, the drop test, and turning a goal's verdict
 //! into a `Transition`.
 
-use std::f64::consts::PI;
 use std::sync::Arc;
 
-use dexcube_sim::rotation::{self, Quat};
+use dexcube_sim::rotation::Quat;
 use dexcube_sim::{HAND_ACTUATORS, Pose, Scene, Sim};
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::goal::Goal;
+use crate::random::standard_normal;
 use crate::{EPISODE_STEPS, Info, Observation, Transition};
 
 /// Observations shared by both environments: joint angles 24, joint velocities 24, object
@@ -70,7 +70,7 @@ impl HandObject {
             self.sim.reset();
             let mut position = self.resting;
             for p in &mut position {
-                *p += START_POSITION_NOISE * normal(&mut self.rng);
+                *p += START_POSITION_NOISE * standard_normal(&mut self.rng);
             }
             let orientation = orientation(&mut self.rng);
             self.sim.set_object_pose(&Pose {
@@ -176,19 +176,4 @@ fn settle(sim: &mut Sim) -> bool {
 /// The same rotation with a non-negative real part.
 pub fn canonical(q: Quat) -> Quat {
     if q[0] < 0.0 { q.map(|x| -x) } else { q }
-}
-
-/// A standard normal draw (Box–Muller).
-fn normal(rng: &mut impl Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
-}
-
-/// A rotation drawn uniformly from SO(3) (Shoemake's method).
-pub fn uniform_rotation(rng: &mut impl Rng) -> Quat {
-    let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
-    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-    let (t2, t3) = (2.0 * PI * u2, 2.0 * PI * u3);
-    rotation::normalise(&[b * t3.cos(), a * t2.sin(), a * t2.cos(), b * t3.sin()])
 }

@@ -22,7 +22,7 @@ use rand::Rng;
 
 use crate::goal::{Goal, LayerGoal, wrap_angle};
 use crate::hand_object::HandObject;
-use crate::{GoalEnv, Info, Observation, Spaces, Transition};
+use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// Which layer faces where, and which way it turns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -172,6 +172,16 @@ fn observe(
     }
 }
 
+impl SimulatedEnv for LayerOpEnv {
+    fn sim(&self) -> &dexcube_sim::Sim {
+        &self.hand.sim
+    }
+
+    fn sim_mut(&mut self) -> &mut dexcube_sim::Sim {
+        &mut self.hand.sim
+    }
+}
+
 impl GoalEnv for LayerOpEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
@@ -210,13 +220,5 @@ impl GoalEnv for LayerOpEnv {
         self.hand.step(action, self.goal.as_ref(), |hand| {
             observe(hand, hinge, desired)
         })
-    }
-
-    fn sim(&self) -> &dexcube_sim::Sim {
-        &self.hand.sim
-    }
-
-    fn sim_mut(&mut self) -> &mut dexcube_sim::Sim {
-        &mut self.hand.sim
     }
 }

@@ -16,6 +16,7 @@
 pub mod goal;
 mod hand_object;
 pub mod layer;
+pub mod random;
 pub mod rot;
 pub mod vec_env;
 
@@ -82,10 +83,12 @@ pub trait GoalEnv: Send {
     /// Starts an episode. A seed re-seeds the environment's generator; `None` continues it.
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info);
 
-    /// Applies an action in [-1, 1]^20 for one control step.
+    /// Applies an action (each component in [-1, 1]) for one step.
     fn step(&mut self, action: &[f64]) -> Transition;
+}
 
-    /// The simulation, for rendering and inspection.
+/// An environment backed by a MuJoCo simulation, for rendering and inspection.
+pub trait SimulatedEnv: GoalEnv {
     fn sim(&self) -> &dexcube_sim::Sim;
     fn sim_mut(&mut self) -> &mut dexcube_sim::Sim;
 }

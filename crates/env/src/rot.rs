@@ -19,8 +19,9 @@ use dexcube_sim::{Scene, SceneKind, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, RotGoal, RotMode};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical, uniform_rotation};
-use crate::{GoalEnv, Info, Observation, Spaces, Transition};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
+use crate::random::uniform_rotation;
+use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// The paper's three Stage 1 targets, `[w, x, y, z]`.
 pub const PAPER_TARGETS: [Quat; 3] = [
@@ -116,6 +117,16 @@ fn target(position: [f64; 3], orientation: Quat) -> Vec<f64> {
         .collect()
 }
 
+impl SimulatedEnv for CubeRotEnv {
+    fn sim(&self) -> &dexcube_sim::Sim {
+        &self.hand.sim
+    }
+
+    fn sim_mut(&mut self) -> &mut dexcube_sim::Sim {
+        &mut self.hand.sim
+    }
+}
+
 impl GoalEnv for CubeRotEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
@@ -144,14 +155,6 @@ impl GoalEnv for CubeRotEnv {
         let desired = &self.desired;
         self.hand
             .step(action, self.goal.as_ref(), |hand| observe(hand, desired))
-    }
-
-    fn sim(&self) -> &dexcube_sim::Sim {
-        &self.hand.sim
-    }
-
-    fn sim_mut(&mut self) -> &mut dexcube_sim::Sim {
-        &mut self.hand.sim
     }
 }
 

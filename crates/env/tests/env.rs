@@ -1,7 +1,7 @@
 //! The goal-env contract of CubeRotEnv and LayerOpEnv, with real physics.
 
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotMode, VecEnv};
+use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotMode, SimulatedEnv, VecEnv};
 use dexcube_sim::Pose;
 use dexcube_sim::rotation::{self, about};
 use rand::{Rng, SeedableRng};

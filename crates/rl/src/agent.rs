@@ -1,0 +1,255 @@
+//! The DDPG agent (Lillicrap et al. 2016) as HER baselines run it: a deterministic actor
+//! π(o, g) = tanh(MLP), a critic Q(o, g, u), target copies of both updated by polyak
+//! averaging once per cycle, and inputs normalised by running statistics.
+//!
+//! One optimisation step on a batch (o, g, u, r, o'):
+//! - target   y = clip(r + γ·Q'(o', g, π'(o', g)), -1/(1-γ), 0), no gradient;
+//! - critic   minimise mean (Q(o, g, u) - y)²;
+//! - actor    minimise -mean Q(o, g, π(o, g)) + action_l2 · mean π(o, g)²;
+//!
+//! both gradients taken from the same forward pass, as baselines does. Target networks live
+//! on the plain (non-autodiff) device, so their updates can never grow an autodiff graph.
+
+use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use crate::config::DdpgHerConfig;
+use crate::networks::Mlp;
+use crate::normalizer::Normalizer;
+use crate::params;
+use dexcube_env::random::standard_normal;
+
+/// Sizes the agent is built for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Dims {
+    pub observation: usize,
+    pub goal: usize,
+    pub action: usize,
+}
+
+/// A batch of transitions, row-major, raw (unnormalised).
+#[derive(Clone, Debug, Default)]
+pub struct Batch {
+    pub len: usize,
+    pub observation: Vec<f64>,
+    pub goal: Vec<f64>,
+    pub action: Vec<f32>,
+    pub reward: Vec<f32>,
+    pub next_observation: Vec<f64>,
+}
+
+/// What one optimisation step measured.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StepStats {
+    pub critic_loss: f64,
+    pub actor_loss: f64,
+    pub mean_q: f64,
+}
+
+pub struct Agent {
+    pub config: DdpgHerConfig,
+    pub dims: Dims,
+    device: Device,
+    plain: Device,
+    actor: Mlp,
+    critic: Mlp,
+    target_actor: Mlp,
+    target_critic: Mlp,
+    /// A no-autodiff copy of the actor for acting, refreshed after each cycle.
+    policy: Mlp,
+    actor_optimizer: ModuleOptimizer,
+    critic_optimizer: ModuleOptimizer,
+    pub observation_norm: Normalizer,
+    pub goal_norm: Normalizer,
+}
+
+impl Agent {
+    /// A fresh agent on `device` (a plain backend device, e.g. `Device::flex()`); burn's
+    /// global seed is set from `seed` so the initial weights are reproducible.
+    pub fn new(dims: Dims, config: DdpgHerConfig, device: &Device, seed: u64) -> Agent {
+        device.seed(seed);
+        let plain = device.clone();
+        let autodiff = device.clone().autodiff();
+        let input = dims.observation + dims.goal;
+        let actor = Mlp::new(input, &config.hidden, dims.action, &autodiff);
+        let critic = Mlp::new(input + dims.action, &config.hidden, 1, &autodiff);
+        let normalizer =
+            |size| Normalizer::new(size, config.norm_eps, config.norm_clip, config.clip_obs);
+        Agent {
+            target_actor: actor.valid(),
+            target_critic: critic.valid(),
+            policy: actor.valid(),
+            actor,
+            critic,
+            actor_optimizer: AdamConfig::new().init(),
+            critic_optimizer: AdamConfig::new().init(),
+            observation_norm: normalizer(dims.observation),
+            goal_norm: normalizer(dims.goal),
+            config,
+            dims,
+            device: autodiff,
+            plain,
+        }
+    }
+
+    /// Normalised network inputs [o, g] for `n` rows.
+    fn inputs(&self, observation: &[f64], goal: &[f64], n: usize, device: &Device) -> Tensor<2> {
+        let (dobs, dgoal) = (self.dims.observation, self.dims.goal);
+        let mut x = Vec::with_capacity(n * (dobs + dgoal));
+        for i in 0..n {
+            self.observation_norm
+                .normalize_into(&observation[i * dobs..(i + 1) * dobs], &mut x);
+            self.goal_norm
+                .normalize_into(&goal[i * dgoal..(i + 1) * dgoal], &mut x);
+        }
+        Tensor::from_data(TensorData::new(x, [n, dobs + dgoal]), device)
+    }
+
+    /// Actions for `n` (observation, goal) rows. Exploring adds Gaussian noise of
+    /// `noise_eps` and, with probability `random_eps`, takes a uniformly random action.
+    pub fn act(
+        &self,
+        observation: &[f64],
+        goal: &[f64],
+        n: usize,
+        explore: Option<&mut ChaCha8Rng>,
+    ) -> Vec<Vec<f64>> {
+        let x = self.inputs(observation, goal, n, &self.plain);
+        let out = self
+            .policy
+            .forward(x)
+            .tanh()
+            .into_data()
+            .convert::<f32>()
+            .try_to_vec::<f32>()
+            .unwrap_or_default();
+        let mut actions: Vec<Vec<f64>> = out
+            .chunks(self.dims.action)
+            .map(|row| row.iter().map(|&a| a as f64).collect())
+            .collect();
+        if let Some(rng) = explore {
+            for action in &mut actions {
+                if rng.random::<f64>() < self.config.random_eps {
+                    action
+                        .iter_mut()
+                        .for_each(|a| *a = rng.random_range(-1.0..=1.0));
+                } else {
+                    for a in action.iter_mut() {
+                        *a = (*a + self.config.noise_eps * standard_normal(rng)).clamp(-1.0, 1.0);
+                    }
+                }
+            }
+        }
+        actions
+    }
+
+    /// One optimisation step of actor and critic on `batch`.
+    pub fn train(&mut self, batch: &Batch) -> StepStats {
+        let (n, da) = (batch.len, self.dims.action);
+        let x = self.inputs(&batch.observation, &batch.goal, n, &self.plain);
+        let x_next = self.inputs(&batch.next_observation, &batch.goal, n, &self.plain);
+        // The target, on the plain device: no gradient can reach it.
+        let next_action = self.target_actor.forward(x_next.clone()).tanh();
+        let next_q = self
+            .target_critic
+            .forward(Tensor::cat(vec![x_next, next_action], 1));
+        let reward: Tensor<2> =
+            Tensor::from_data(TensorData::new(batch.reward.clone(), [n, 1]), &self.plain);
+        let target = (reward + next_q * self.config.gamma).clamp(-self.config.clip_return(), 0.0);
+        let target: Tensor<2> = Tensor::from_data(target.into_data(), &self.device);
+
+        let x: Tensor<2> = Tensor::from_data(x.into_data(), &self.device);
+        let action: Tensor<2> =
+            Tensor::from_data(TensorData::new(batch.action.clone(), [n, da]), &self.device);
+        let q = self.critic.forward(Tensor::cat(vec![x.clone(), action], 1));
+        let critic_loss = (q.clone() - target).powi_scalar(2).mean();
+        let pi = self.actor.forward(x.clone()).tanh();
+        let q_pi = self.critic.forward(Tensor::cat(vec![x, pi.clone()], 1));
+        let actor_loss = q_pi.mean().neg() + pi.powi_scalar(2).mean() * self.config.action_l2;
+
+        let stats = StepStats {
+            critic_loss: scalar(&critic_loss),
+            actor_loss: scalar(&actor_loss),
+            mean_q: scalar(&q.mean()),
+        };
+        let critic_grads = GradientsParams::from_grads(critic_loss.backward(), &self.critic);
+        let actor_grads = GradientsParams::from_grads(actor_loss.backward(), &self.actor);
+        self.critic =
+            self.critic_optimizer
+                .step(self.config.critic_lr, self.critic.clone(), critic_grads);
+        self.actor =
+            self.actor_optimizer
+                .step(self.config.actor_lr, self.actor.clone(), actor_grads);
+        stats
+    }
+
+    /// Polyak-averages the targets towards the networks, and refreshes the acting policy.
+    pub fn end_cycle(&mut self) {
+        let keep = self.config.polyak as f32;
+        let blend = |target: &[f32], online: &[f32]| {
+            target
+                .iter()
+                .zip(online)
+                .map(|(t, o)| keep * t + (1.0 - keep) * o)
+                .collect()
+        };
+        let online_actor = params::read(&self.actor.valid());
+        let online_critic = params::read(&self.critic.valid());
+        self.target_actor =
+            params::write(self.target_actor.clone(), &online_actor, blend).expect("same layout");
+        self.target_critic =
+            params::write(self.target_critic.clone(), &online_critic, blend).expect("same layout");
+        self.policy = self.actor.valid();
+    }
+
+    /// True when no target-network parameter requires a gradient (they live on the plain
+    /// device): the guard against burn's target-network pitfalls.
+    pub fn targets_track_no_gradients(&self) -> bool {
+        struct AnyGrad(bool);
+        impl burn::module::ModuleVisitor for AnyGrad {
+            fn visit_float<const D: usize>(&mut self, param: &burn::module::Param<Tensor<D>>) {
+                self.0 |= param.val().is_require_grad();
+            }
+        }
+        let mut any = AnyGrad(false);
+        self.target_actor.visit(&mut any);
+        self.target_critic.visit(&mut any);
+        !any.0
+    }
+
+    /// The four networks' parameters, for checkpoints: actor, critic, target actor, target critic.
+    pub fn networks(&self) -> [Vec<params::NamedTensor>; 4] {
+        [
+            params::read(&self.actor.valid()),
+            params::read(&self.critic.valid()),
+            params::read(&self.target_actor),
+            params::read(&self.target_critic),
+        ]
+    }
+
+    /// Loads the four networks saved by `networks` (Adam's moments start afresh).
+    pub fn load_networks(
+        &mut self,
+        saved: &[Vec<params::NamedTensor>; 4],
+    ) -> Result<(), params::ParamMismatch> {
+        let replace = |_: &[f32], given: &[f32]| given.to_vec();
+        self.actor = params::write(self.actor.clone(), &saved[0], replace)?.train();
+        self.critic = params::write(self.critic.clone(), &saved[1], replace)?.train();
+        self.target_actor = params::write(self.target_actor.clone(), &saved[2], replace)?;
+        self.target_critic = params::write(self.target_critic.clone(), &saved[3], replace)?;
+        self.policy = self.actor.valid();
+        Ok(())
+    }
+}
+
+fn scalar(t: &Tensor<1>) -> f64 {
+    t.to_data()
+        .convert::<f64>()
+        .try_to_vec::<f64>()
+        .ok()
+        .and_then(|v| v.first().copied())
+        .unwrap_or(f64::NAN)
+}

@@ -1,0 +1,87 @@
+//! Every DDPG + HER hyperparameter in one struct. The defaults are those of the HER baselines
+//! (Andrychowicz et al., "Hindsight Experience Replay", NeurIPS 2017; OpenAI baselines,
+//! `her/experiment/config.py`, `DEFAULT_PARAMS`), which Li et al. trained with.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct DdpgHerConfig {
+    /// Hidden layers of both networks (baselines: `layers` 3, `hidden` 256; the paper's 3x256).
+    pub hidden: Vec<usize>,
+    /// Adam learning rate of the actor (`pi_lr`).
+    pub actor_lr: f64,
+    /// Adam learning rate of the critic (`Q_lr`).
+    pub critic_lr: f64,
+    /// Transitions per optimisation batch (`batch_size`).
+    pub batch_size: usize,
+    /// Target networks keep this share of themselves at each update (`polyak`).
+    pub polyak: f64,
+    /// Weight of the squared-action penalty in the actor's loss (`action_l2`).
+    pub action_l2: f64,
+    /// Discount; baselines use 1 - 1/T with T the episode length (100 here).
+    pub gamma: f64,
+    /// Replay capacity in transitions (`buffer_size`).
+    pub buffer_size: usize,
+    /// HER "future" relabelling: k relabelled goals per real one, probability k/(k+1) = 0.8.
+    pub replay_k: usize,
+    /// Relabel with Hindsight Experience Replay; off gives plain DDPG, for ablations.
+    pub her: bool,
+    /// Normalised inputs are clipped to ±this (`norm_clip`).
+    pub norm_clip: f64,
+    /// Smallest standard deviation a normaliser divides by (`norm_eps`).
+    pub norm_eps: f64,
+    /// Raw observations and goals are clipped to ±this first (`clip_obs`).
+    pub clip_obs: f64,
+    /// Gaussian exploration noise, as a share of the action range (`noise_eps`).
+    pub noise_eps: f64,
+    /// Probability of a uniformly random action while exploring (`random_eps`).
+    pub random_eps: f64,
+    /// Cycles per epoch (`n_cycles`).
+    pub cycles_per_epoch: usize,
+    /// Optimisation batches per cycle (`n_batches`).
+    pub batches_per_cycle: usize,
+    /// Deterministic test episodes per epoch (`n_test_rollouts`).
+    pub test_episodes: usize,
+}
+
+impl Default for DdpgHerConfig {
+    fn default() -> Self {
+        DdpgHerConfig {
+            hidden: vec![256, 256, 256],
+            actor_lr: 1e-3,
+            critic_lr: 1e-3,
+            batch_size: 256,
+            polyak: 0.95,
+            action_l2: 1.0,
+            gamma: 1.0 - 1.0 / 100.0,
+            buffer_size: 1_000_000,
+            replay_k: 4,
+            her: true,
+            norm_clip: 5.0,
+            norm_eps: 0.01,
+            clip_obs: 200.0,
+            noise_eps: 0.2,
+            random_eps: 0.3,
+            cycles_per_epoch: 50,
+            batches_per_cycle: 40,
+            test_episodes: 10,
+        }
+    }
+}
+
+impl DdpgHerConfig {
+    /// Targets are clipped to [-1/(1-γ), 0], the range of a sparse -1/0 return.
+    pub fn clip_return(&self) -> f64 {
+        1.0 / (1.0 - self.gamma)
+    }
+
+    /// Probability that a sampled transition gets a relabelled goal.
+    pub fn future_probability(&self) -> f64 {
+        if self.her {
+            1.0 - 1.0 / (1.0 + self.replay_k as f64)
+        } else {
+            0.0
+        }
+    }
+}

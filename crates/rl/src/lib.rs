@@ -1,0 +1,34 @@
+//! # dexcube-rl
+//!
+//! DDPG (Lillicrap et al. 2016) with Hindsight Experience Replay (Andrychowicz et al. 2017),
+//! as the paper trained its two atomic actions, on burn. Read it top to bottom:
+//!
+//! - [`config`]: every hyperparameter, with the HER baselines' defaults, cited;
+//! - [`normalizer`]: running statistics of observations and goals;
+//! - [`networks`] and [`agent`]: the actor, the critic, their targets and the update;
+//! - [`replay`]: the HER buffer, relabelling goals at sampling time;
+//! - [`rollout`]: episodes from a `VecEnv`;
+//! - [`train`]: the epoch / cycle / batch schedule with checkpoints, curves and resume;
+//! - [`policy`]: a trained actor as shipped, with its normalisers;
+//! - [`point_mass`]: a small reaching task that proves the learner in seconds.
+//!
+//! Networks run on burn's `flex` CPU backend with one intra-op thread; the code names no
+//! backend, so a CUDA device runs it unchanged where burn is built with `cuda`.
+
+pub mod agent;
+pub mod checkpoint;
+pub mod config;
+pub mod networks;
+pub mod normalizer;
+pub mod params;
+pub mod plot;
+pub mod point_mass;
+pub mod policy;
+pub mod replay;
+pub mod rollout;
+pub mod train;
+
+pub use agent::{Agent, Dims};
+pub use config::DdpgHerConfig;
+pub use policy::Policy;
+pub use train::{EpochMetrics, TrainOptions, train};

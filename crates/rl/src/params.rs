@@ -1,0 +1,139 @@
+//! A module's parameters by name, read out and written back, for polyak averaging and for
+//! safetensors checkpoints. Names are burn's module paths, e.g. `layers.0.weight`.
+
+use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
+use burn::prelude::*;
+use burn::tensor::TensorData;
+
+/// One parameter tensor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedTensor {
+    pub name: String,
+    pub shape: Vec<usize>,
+    pub values: Vec<f32>,
+}
+
+/// Every float parameter of `module`, in visiting order.
+pub fn read<M: Module>(module: &M) -> Vec<NamedTensor> {
+    struct Reader {
+        path: Vec<String>,
+        out: Vec<NamedTensor>,
+    }
+    impl ModuleVisitor for Reader {
+        fn enter_module(&mut self, name: &str, _: &str) {
+            self.path.push(name.to_string());
+        }
+        fn exit_module(&mut self, _: &str, _: &str) {
+            self.path.pop();
+        }
+        fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+            let tensor = param.val();
+            let shape = tensor.dims().to_vec();
+            let values = tensor
+                .into_data()
+                .convert::<f32>()
+                .try_to_vec::<f32>()
+                .unwrap_or_default();
+            self.out.push(NamedTensor {
+                name: self.path.join("."),
+                shape,
+                values,
+            });
+        }
+    }
+    let mut reader = Reader {
+        path: vec![],
+        out: vec![],
+    };
+    module.visit(&mut reader);
+    reader.out
+}
+
+/// A parameter that did not fit.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamMismatch {
+    Missing(String),
+    Shape {
+        name: String,
+        expected: Vec<usize>,
+        found: Vec<usize>,
+    },
+}
+
+impl std::fmt::Display for ParamMismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ParamMismatch::Missing(name) => write!(f, "no tensor named '{name}'"),
+            ParamMismatch::Shape {
+                name,
+                expected,
+                found,
+            } => {
+                write!(
+                    f,
+                    "'{name}' has shape {found:?}, the network needs {expected:?}"
+                )
+            }
+        }
+    }
+}
+
+/// `module` with each parameter replaced by `blend(current, given)`, where `given` is the
+/// tensor of the same name in `values`. The results are detached from any autodiff graph.
+pub fn write<M: Module>(
+    module: M,
+    values: &[NamedTensor],
+    blend: impl Fn(&[f32], &[f32]) -> Vec<f32>,
+) -> Result<M, ParamMismatch> {
+    struct Writer<'a, B> {
+        path: Vec<String>,
+        values: &'a [NamedTensor],
+        blend: B,
+        error: Option<ParamMismatch>,
+    }
+    impl<B: Fn(&[f32], &[f32]) -> Vec<f32>> ModuleMapper for Writer<'_, B> {
+        fn enter_module(&mut self, name: &str, _: &str) {
+            self.path.push(name.to_string());
+        }
+        fn exit_module(&mut self, _: &str, _: &str) {
+            self.path.pop();
+        }
+        fn map_float<const D: usize>(&mut self, param: Param<Tensor<D>>) -> Param<Tensor<D>> {
+            let name = self.path.join(".");
+            let Some(given) = self.values.iter().find(|v| v.name == name) else {
+                self.error.get_or_insert(ParamMismatch::Missing(name));
+                return param;
+            };
+            param.map(|tensor| {
+                let expected = tensor.dims().to_vec();
+                if given.shape != expected {
+                    self.error.get_or_insert(ParamMismatch::Shape {
+                        name: name.clone(),
+                        expected,
+                        found: given.shape.clone(),
+                    });
+                    return tensor;
+                }
+                let device = tensor.device();
+                let current = tensor
+                    .into_data()
+                    .convert::<f32>()
+                    .try_to_vec::<f32>()
+                    .unwrap_or_default();
+                let blended = (self.blend)(&current, &given.values);
+                Tensor::from_data(TensorData::new(blended, given.shape.clone()), &device).detach()
+            })
+        }
+    }
+    let mut writer = Writer {
+        path: vec![],
+        values,
+        blend,
+        error: None,
+    };
+    let module = module.map(&mut writer);
+    match writer.error {
+        Some(error) => Err(error),
+        None => Ok(module),
+    }
+}

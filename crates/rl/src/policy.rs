@@ -1,0 +1,102 @@
+//! A trained policy as shipped: the actor's weights (`NAME.safetensors`) and a JSON beside it
+//! (`NAME.json`) with the sizes, the normalisers, the training configuration and whatever
+//! metrics the trainer recorded. It acts without the critic or any optimiser state.
+
+use std::path::{Path, PathBuf};
+
+use burn::prelude::*;
+use burn::tensor::TensorData;
+use serde::{Deserialize, Serialize};
+
+use crate::agent::{Agent, Dims};
+use crate::checkpoint::{self, CheckpointError};
+use crate::config::DdpgHerConfig;
+use crate::networks::Mlp;
+use crate::normalizer::Normalizer;
+use crate::params;
+
+/// Everything about a policy but its weights.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PolicyCard {
+    pub dims: Dims,
+    pub config: DdpgHerConfig,
+    pub observation_norm: Normalizer,
+    pub goal_norm: Normalizer,
+    /// Free-form facts: environment, seed, steps, wall time, evaluation.
+    pub metadata: serde_json::Value,
+}
+
+pub struct Policy {
+    pub card: PolicyCard,
+    actor: Mlp,
+    device: Device,
+}
+
+/// `prefix.safetensors` and `prefix.json`.
+pub fn policy_paths(prefix: &Path) -> (PathBuf, PathBuf) {
+    (
+        prefix.with_extension("safetensors"),
+        prefix.with_extension("json"),
+    )
+}
+
+impl Policy {
+    /// Saves an agent's actor as a policy at `prefix`.
+    pub fn save(
+        agent: &Agent,
+        prefix: &Path,
+        metadata: serde_json::Value,
+    ) -> Result<(), CheckpointError> {
+        let (weights, card_path) = policy_paths(prefix);
+        let card = PolicyCard {
+            dims: agent.dims,
+            config: agent.config.clone(),
+            observation_norm: agent.observation_norm.clone(),
+            goal_norm: agent.goal_norm.clone(),
+            metadata,
+        };
+        checkpoint::save_tensors(&weights, &agent.networks()[0])?;
+        checkpoint::save_json(&card_path, &card)
+    }
+
+    /// Loads the policy at `prefix` onto `device`.
+    pub fn load(prefix: &Path, device: &Device) -> Result<Policy, CheckpointError> {
+        let (weights, card_path) = policy_paths(prefix);
+        let card: PolicyCard = checkpoint::load_json(&card_path)?;
+        let tensors = checkpoint::load_tensors(&weights)?;
+        let Dims {
+            observation,
+            goal,
+            action,
+        } = card.dims;
+        let actor = Mlp::new(observation + goal, &card.config.hidden, action, device);
+        let actor = params::write(actor, &tensors, |_, given| given.to_vec()).map_err(|e| {
+            CheckpointError::Mismatch {
+                path: weights.clone(),
+                message: e.to_string(),
+            }
+        })?;
+        Ok(Policy {
+            card,
+            actor,
+            device: device.clone(),
+        })
+    }
+
+    /// The deterministic action for one observation and goal.
+    pub fn act(&self, observation: &[f64], goal: &[f64]) -> Vec<f64> {
+        let Dims {
+            observation: dobs,
+            goal: dgoal,
+            ..
+        } = self.card.dims;
+        let mut x = Vec::with_capacity(dobs + dgoal);
+        self.card
+            .observation_norm
+            .normalize_into(observation, &mut x);
+        self.card.goal_norm.normalize_into(goal, &mut x);
+        let x: Tensor<2> = Tensor::from_data(TensorData::new(x, [1, dobs + dgoal]), &self.device);
+        let out = self.actor.forward(x).tanh().into_data().convert::<f64>();
+        out.try_to_vec::<f64>().unwrap_or_default()
+    }
+}

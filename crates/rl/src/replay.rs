@@ -1,0 +1,220 @@
+//! The Hindsight Experience Replay buffer: whole episodes are stored, and goals are relabelled
+//! when a batch is sampled, with the "future" strategy: with probability k/(k+1) a transition's
+//! goal becomes the goal achieved at a uniformly chosen later step of its own episode, and its
+//! reward is recomputed by the environment's pure reward function.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use dexcube_env::Goal;
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use crate::agent::{Batch, Dims};
+
+/// One episode of `len` steps: observations and achieved goals at steps 0..=len, desired
+/// goals and actions at steps 0..len, each row-major.
+#[derive(Clone, Debug, Default)]
+pub struct Episode {
+    pub len: usize,
+    pub observation: Vec<f64>,
+    pub achieved_goal: Vec<f64>,
+    pub desired_goal: Vec<f64>,
+    pub action: Vec<f32>,
+}
+
+pub struct HerBuffer {
+    dims: Dims,
+    capacity: usize,
+    episodes: VecDeque<Episode>,
+    transitions: usize,
+    longest: usize,
+    future_probability: f64,
+    goal: Arc<dyn Goal>,
+}
+
+impl HerBuffer {
+    /// A buffer of up to `capacity` transitions; the oldest episodes go first.
+    pub fn new(
+        dims: Dims,
+        capacity: usize,
+        future_probability: f64,
+        goal: Arc<dyn Goal>,
+    ) -> HerBuffer {
+        HerBuffer {
+            dims,
+            capacity,
+            episodes: VecDeque::new(),
+            transitions: 0,
+            longest: 0,
+            future_probability,
+            goal,
+        }
+    }
+
+    pub fn transitions(&self) -> usize {
+        self.transitions
+    }
+
+    pub fn store(&mut self, episode: Episode) {
+        if episode.len == 0 {
+            return;
+        }
+        self.transitions += episode.len;
+        self.longest = self.longest.max(episode.len);
+        self.episodes.push_back(episode);
+        while self.transitions > self.capacity {
+            let old = self.episodes.pop_front().expect("transitions > 0");
+            self.transitions -= old.len;
+        }
+    }
+
+    /// A transition drawn uniformly over all stored transitions, relabelled as HER does:
+    /// its (episode, step) and the step whose achieved goal is its goal.
+    fn draw(&self, rng: &mut ChaCha8Rng) -> (&Episode, usize, Option<usize>) {
+        loop {
+            // Uniform over transitions: an episode drawn uniformly, kept in proportion to its
+            // length (rejection), then a step within it.
+            let episode = &self.episodes[rng.random_range(0..self.episodes.len())];
+            if rng.random_range(0..self.longest) >= episode.len {
+                continue;
+            }
+            let t = rng.random_range(0..episode.len);
+            let future = (rng.random::<f64>() < self.future_probability)
+                .then(|| rng.random_range(t + 1..=episode.len));
+            return (episode, t, future);
+        }
+    }
+
+    /// `size` relabelled transitions; rewards come from the goal's reward function.
+    pub fn sample(&self, size: usize, rng: &mut ChaCha8Rng) -> Batch {
+        let Dims {
+            observation: dobs,
+            goal: dgoal,
+            action: dact,
+        } = self.dims;
+        let mut batch = Batch {
+            len: size,
+            ..Batch::default()
+        };
+        for _ in 0..size {
+            let (episode, t, future) = self.draw(rng);
+            let goal = match future {
+                Some(f) => &episode.achieved_goal[f * dgoal..(f + 1) * dgoal],
+                None => &episode.desired_goal[t * dgoal..(t + 1) * dgoal],
+            };
+            let achieved_next = &episode.achieved_goal[(t + 1) * dgoal..(t + 2) * dgoal];
+            batch
+                .reward
+                .push(self.goal.compute_reward(achieved_next, goal) as f32);
+            batch
+                .observation
+                .extend_from_slice(&episode.observation[t * dobs..(t + 1) * dobs]);
+            batch
+                .next_observation
+                .extend_from_slice(&episode.observation[(t + 1) * dobs..(t + 2) * dobs]);
+            batch.goal.extend_from_slice(goal);
+            batch
+                .action
+                .extend_from_slice(&episode.action[t * dact..(t + 1) * dact]);
+        }
+        batch
+    }
+
+    /// Observations and relabelled goals from one episode, as HER baselines feed its
+    /// normalisers: `count` draws with the same relabelling as training batches.
+    pub fn normalizer_rows(
+        &self,
+        episode: &Episode,
+        count: usize,
+        rng: &mut ChaCha8Rng,
+    ) -> Vec<(Vec<f64>, Vec<f64>)> {
+        let Dims {
+            observation: dobs,
+            goal: dgoal,
+            ..
+        } = self.dims;
+        (0..count)
+            .map(|_| {
+                let t = rng.random_range(0..episode.len);
+                let use_future = rng.random::<f64>() < self.future_probability;
+                let g = if use_future {
+                    let f = rng.random_range(t + 1..=episode.len);
+                    &episode.achieved_goal[f * dgoal..(f + 1) * dgoal]
+                } else {
+                    &episode.desired_goal[t * dgoal..(t + 1) * dgoal]
+                };
+                (
+                    episode.observation[t * dobs..(t + 1) * dobs].to_vec(),
+                    g.to_vec(),
+                )
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dexcube_env::LayerGoal;
+    use rand::SeedableRng;
+
+    /// A one-dimensional episode whose achieved goal counts its steps.
+    fn counting_episode(len: usize, desired: f64) -> Episode {
+        Episode {
+            len,
+            observation: (0..=len).map(|t| t as f64).collect(),
+            achieved_goal: (0..=len).map(|t| t as f64).collect(),
+            desired_goal: vec![desired; len],
+            action: vec![0.0; len],
+        }
+    }
+
+    #[test]
+    fn relabelled_goals_come_from_later_in_the_same_episode() {
+        let dims = Dims {
+            observation: 1,
+            goal: 1,
+            action: 1,
+        };
+        let mut buffer = HerBuffer::new(
+            dims,
+            1000,
+            0.8,
+            Arc::new(LayerGoal {
+                angle_threshold: 0.5,
+            }),
+        );
+        buffer.store(counting_episode(10, 100.0));
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        let batch = buffer.sample(2000, &mut rng);
+        let relabelled = batch.goal.iter().filter(|&&g| g != 100.0).count() as f64 / 2000.0;
+        assert!((relabelled - 0.8).abs() < 0.04, "{relabelled}");
+        for i in 0..batch.len {
+            let (o, g, r) = (batch.observation[i], batch.goal[i], batch.reward[i]);
+            if g != 100.0 {
+                assert!(g > o && g <= 10.0, "a future goal: step {o}, goal {g}");
+            }
+            // Success exactly when the next achieved goal (o + 1) is the goal.
+            assert_eq!(r, if (o + 1.0 - g).abs() < 0.5 { 0.0 } else { -1.0 });
+        }
+        assert!(batch.reward.contains(&0.0), "hindsight makes successes");
+    }
+
+    #[test]
+    fn without_her_goals_are_never_relabelled_and_old_episodes_leave() {
+        let dims = Dims {
+            observation: 1,
+            goal: 1,
+            action: 1,
+        };
+        let mut buffer = HerBuffer::new(dims, 25, 0.0, Arc::new(LayerGoal::default()));
+        for _ in 0..3 {
+            buffer.store(counting_episode(10, 100.0));
+        }
+        assert_eq!(buffer.transitions(), 20, "the oldest episode made room");
+        let batch = buffer.sample(500, &mut ChaCha8Rng::seed_from_u64(1));
+        assert!(batch.goal.iter().all(|&g| g == 100.0));
+        assert!(batch.reward.iter().all(|&r| r == -1.0));
+    }
+}

@@ -1,0 +1,394 @@
+//! The training loop, HER baselines' schedule: an epoch is `cycles_per_epoch` cycles; a cycle
+//! collects one exploring episode from every environment, feeds the normalisers and the
+//! replay buffer, runs `batches_per_cycle` optimisation steps and updates the targets; each
+//! epoch ends with deterministic test episodes. After every epoch it writes, atomically:
+//!
+//! - `checkpoint/`: all four networks and `state.json` (config, normalisers, progress),
+//!   from which `resume` continues. Adam's moments and the replay buffer start empty on
+//!   resume; the networks, normalisers, metrics and episode count carry over.
+//! - `best.safetensors` + `best.json`: the policy with the highest test success so far.
+//! - `policy.safetensors` + `policy.json`: the latest policy.
+//! - `metrics.csv` and `success.png`: the learning curve.
+//!
+//! Every random choice comes from the seed: environment `i` of the `k`-th batch of episodes
+//! is reset with a seed derived from (seed, k, i), and exploration noise from (seed, epoch).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use burn::prelude::*;
+use dexcube_env::{GoalEnv, VecEnv};
+use indicatif::{ProgressBar, ProgressStyle};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::agent::{Agent, Dims, StepStats};
+use crate::checkpoint::{self, CheckpointError};
+use crate::config::DdpgHerConfig;
+use crate::normalizer::Normalizer;
+use crate::plot::{Series, line_plot};
+use crate::policy::Policy;
+use crate::replay::HerBuffer;
+use crate::rollout::rollout;
+
+pub struct TrainOptions {
+    pub epochs: usize,
+    /// Environments stepped together; each gives one episode per cycle.
+    pub envs: usize,
+    /// Threads stepping the environments.
+    pub threads: usize,
+    pub seed: u64,
+    /// Where checkpoints, policies and curves go; `None` keeps everything in memory.
+    pub out_dir: Option<PathBuf>,
+    /// Continue from `out_dir/checkpoint` if it exists.
+    pub resume: bool,
+    /// Show a progress bar with ETA on stderr.
+    pub progress: bool,
+    /// What is being trained, for plots and policy cards.
+    pub label: String,
+    /// Facts about the environment, recorded in policy cards.
+    pub metadata: serde_json::Value,
+}
+
+/// One epoch's record, a row of `metrics.csv`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct EpochMetrics {
+    pub epoch: usize,
+    pub episodes: usize,
+    pub env_steps: usize,
+    pub updates: usize,
+    pub test_success: f64,
+    pub train_success: f64,
+    pub mean_q: f64,
+    pub critic_loss: f64,
+    pub actor_loss: f64,
+    /// Environment steps per second over the epoch's wall time.
+    pub env_steps_per_s: f64,
+    /// Seconds of the epoch spent collecting episodes (physics and acting), learning
+    /// (sampling and optimisation), and the rest.
+    pub rollout_s: f64,
+    pub learning_s: f64,
+    pub other_s: f64,
+    /// Seconds since training began, resumed runs included.
+    pub wall_s: f64,
+}
+
+const CSV_HEADER: &str = "epoch,episodes,env_steps,updates,test_success,train_success,mean_q,critic_loss,actor_loss,env_steps_per_s,rollout_s,learning_s,other_s,wall_s";
+
+impl EpochMetrics {
+    fn csv_row(&self) -> String {
+        format!(
+            "{},{},{},{},{:.4},{:.4},{:.4},{:.6},{:.6},{:.1},{:.2},{:.2},{:.2},{:.1}",
+            self.epoch,
+            self.episodes,
+            self.env_steps,
+            self.updates,
+            self.test_success,
+            self.train_success,
+            self.mean_q,
+            self.critic_loss,
+            self.actor_loss,
+            self.env_steps_per_s,
+            self.rollout_s,
+            self.learning_s,
+            self.other_s,
+            self.wall_s
+        )
+    }
+}
+
+/// Everything needed to continue training, beside the networks.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct TrainState {
+    label: String,
+    seed: u64,
+    dims: Dims,
+    config: DdpgHerConfig,
+    observation_norm: Normalizer,
+    goal_norm: Normalizer,
+    metrics: Vec<EpochMetrics>,
+}
+
+#[derive(Debug)]
+pub enum TrainError {
+    Checkpoint(CheckpointError),
+    Resume(String),
+}
+
+impl std::fmt::Display for TrainError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TrainError::Checkpoint(e) => e.fmt(f),
+            TrainError::Resume(message) => write!(f, "cannot resume: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for TrainError {}
+
+impl From<CheckpointError> for TrainError {
+    fn from(e: CheckpointError) -> Self {
+        TrainError::Checkpoint(e)
+    }
+}
+
+/// The outcome: every epoch's metrics (resumed ones included) and the trained agent.
+pub struct Trained {
+    pub metrics: Vec<EpochMetrics>,
+    pub agent: Agent,
+}
+
+const NETWORK_FILES: [&str; 4] = ["actor", "critic", "target_actor", "target_critic"];
+
+/// A seed for the `batch`-th batch of episodes, distinct for training and testing.
+fn episode_seed(seed: u64, batch: u64, test: bool) -> u64 {
+    seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (batch << 20) ^ ((test as u64) << 62)
+}
+
+/// Trains DDPG + HER on environments made by `make_env`.
+pub fn train<E: GoalEnv>(
+    make_env: impl Fn() -> E,
+    config: DdpgHerConfig,
+    options: &TrainOptions,
+) -> Result<Trained, TrainError> {
+    let probe = make_env();
+    let spaces = probe.spaces();
+    let goal = probe.goal();
+    drop(probe);
+    let dims = Dims {
+        observation: spaces.observation,
+        goal: spaces.goal,
+        action: spaces.action,
+    };
+    let mut envs = VecEnv::new(
+        (0..options.envs).map(|_| make_env()).collect(),
+        options.threads,
+    );
+    let mut agent = Agent::new(dims, config.clone(), &Device::flex(), options.seed);
+    let mut buffer = HerBuffer::new(dims, config.buffer_size, config.future_probability(), goal);
+    let mut metrics: Vec<EpochMetrics> = Vec::new();
+    if let (true, Some(dir)) = (options.resume, &options.out_dir) {
+        metrics = resume(&mut agent, dir, options)?;
+    }
+    let cycles = config.cycles_per_epoch as u64;
+    let bar = progress_bar(options, config.cycles_per_epoch, metrics.len());
+    let wall_before = metrics.last().map_or(0.0, |m| m.wall_s);
+    let started = Instant::now();
+    let mut best = metrics
+        .iter()
+        .map(|m| m.test_success)
+        .fold(f64::NEG_INFINITY, f64::max);
+    for epoch in metrics.len()..options.epochs {
+        let epoch_start = Instant::now();
+        let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+        rng.set_stream(epoch as u64);
+        let (mut rollout_s, mut learning_s) = (0.0, 0.0);
+        let (mut train_successes, mut train_episodes, mut steps) = (0, 0, 0);
+        let mut stats = StepStats::default();
+        for cycle in 0..cycles {
+            let t = Instant::now();
+            let (episodes, s) = rollout(
+                &mut envs,
+                &agent,
+                episode_seed(options.seed, epoch as u64 * cycles + cycle, false),
+                Some(&mut rng),
+            );
+            rollout_s += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            (train_successes, train_episodes, steps) = (
+                train_successes + s.successes,
+                train_episodes + s.episodes,
+                steps + s.steps,
+            );
+            for episode in episodes {
+                for (o, g) in buffer.normalizer_rows(&episode, episode.len, &mut rng) {
+                    agent.observation_norm.update(&o);
+                    agent.goal_norm.update(&g);
+                }
+                buffer.store(episode);
+            }
+            for _ in 0..config.batches_per_cycle {
+                let batch = buffer.sample(config.batch_size, &mut rng);
+                let s = agent.train(&batch);
+                stats.critic_loss +=
+                    s.critic_loss / (cycles as usize * config.batches_per_cycle) as f64;
+                stats.actor_loss +=
+                    s.actor_loss / (cycles as usize * config.batches_per_cycle) as f64;
+                stats.mean_q += s.mean_q / (cycles as usize * config.batches_per_cycle) as f64;
+            }
+            agent.end_cycle();
+            learning_s += t.elapsed().as_secs_f64();
+            bar.inc(1);
+        }
+        let t = Instant::now();
+        let test_batches = config.test_episodes.div_ceil(options.envs).max(1) as u64;
+        let (mut test_successes, mut test_episodes) = (0, 0);
+        for k in 0..test_batches {
+            let (_, s) = rollout(
+                &mut envs,
+                &agent,
+                episode_seed(options.seed, epoch as u64 * test_batches + k, true),
+                None,
+            );
+            (test_successes, test_episodes) =
+                (test_successes + s.successes, test_episodes + s.episodes);
+        }
+        rollout_s += t.elapsed().as_secs_f64();
+        let previous = metrics.last();
+        let epoch_s = epoch_start.elapsed().as_secs_f64();
+        let row = EpochMetrics {
+            epoch,
+            episodes: previous.map_or(0, |m| m.episodes) + train_episodes,
+            env_steps: previous.map_or(0, |m| m.env_steps) + steps,
+            updates: previous.map_or(0, |m| m.updates) + cycles as usize * config.batches_per_cycle,
+            test_success: test_successes as f64 / test_episodes as f64,
+            train_success: train_successes as f64 / train_episodes.max(1) as f64,
+            mean_q: stats.mean_q,
+            critic_loss: stats.critic_loss,
+            actor_loss: stats.actor_loss,
+            env_steps_per_s: steps as f64 / epoch_s,
+            rollout_s,
+            learning_s,
+            other_s: (epoch_s - rollout_s - learning_s).max(0.0),
+            wall_s: wall_before + started.elapsed().as_secs_f64(),
+        };
+        bar.set_message(format!("test success {:.2}", row.test_success));
+        let improved = row.test_success > best;
+        best = best.max(row.test_success);
+        metrics.push(row);
+        if let Some(dir) = &options.out_dir {
+            save_epoch(&agent, dir, options, &metrics, improved)?;
+        }
+    }
+    bar.finish();
+    Ok(Trained { metrics, agent })
+}
+
+fn progress_bar(options: &TrainOptions, cycles: usize, done_epochs: usize) -> ProgressBar {
+    if !options.progress {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new((options.epochs * cycles) as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{prefix} [{elapsed_precise}] {wide_bar} epoch {pos}/{len} cycles, ETA {eta} {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_prefix(options.label.clone());
+    bar.set_position((done_epochs * cycles) as u64);
+    bar
+}
+
+fn card_metadata(options: &TrainOptions, metrics: &[EpochMetrics]) -> serde_json::Value {
+    let last = metrics.last();
+    serde_json::json!({
+        "label": options.label,
+        "environment": options.metadata,
+        "seed": options.seed,
+        "envs": options.envs,
+        "epochs": metrics.len(),
+        "episodes": last.map_or(0, |m| m.episodes),
+        "env_steps": last.map_or(0, |m| m.env_steps),
+        "updates": last.map_or(0, |m| m.updates),
+        "wall_s": last.map_or(0.0, |m| m.wall_s),
+        "test_success": last.map_or(0.0, |m| m.test_success),
+    })
+}
+
+fn save_epoch(
+    agent: &Agent,
+    dir: &Path,
+    options: &TrainOptions,
+    metrics: &[EpochMetrics],
+    improved: bool,
+) -> Result<(), TrainError> {
+    let checkpoint_dir = dir.join("checkpoint");
+    for (name, tensors) in NETWORK_FILES.iter().zip(agent.networks()) {
+        checkpoint::save_tensors(
+            &checkpoint_dir.join(format!("{name}.safetensors")),
+            &tensors,
+        )?;
+    }
+    let state = TrainState {
+        label: options.label.clone(),
+        seed: options.seed,
+        dims: agent.dims,
+        config: agent.config.clone(),
+        observation_norm: agent.observation_norm.clone(),
+        goal_norm: agent.goal_norm.clone(),
+        metrics: metrics.to_vec(),
+    };
+    // The state goes last: a checkpoint is complete once state.json names its epoch.
+    checkpoint::save_json(&checkpoint_dir.join("state.json"), &state)?;
+    let metadata = card_metadata(options, metrics);
+    Policy::save(agent, &dir.join("policy"), metadata.clone())?;
+    if improved {
+        Policy::save(agent, &dir.join("best"), metadata)?;
+    }
+    let csv: Vec<String> = std::iter::once(CSV_HEADER.to_string())
+        .chain(metrics.iter().map(EpochMetrics::csv_row))
+        .collect();
+    checkpoint::write_atomically(&dir.join("metrics.csv"), (csv.join("\n") + "\n").as_bytes())?;
+    let curve = Series {
+        label: format!("test success (seed {})", options.seed),
+        points: metrics
+            .iter()
+            .map(|m| (m.episodes as f64, m.test_success))
+            .collect(),
+        band: None,
+    };
+    if let Err(e) = line_plot(
+        &dir.join("success.png"),
+        &options.label,
+        "training episodes",
+        "test success rate",
+        1.0,
+        &[curve],
+    ) {
+        eprintln!("warning: no learning-curve plot: {e}");
+    }
+    Ok(())
+}
+
+fn resume(
+    agent: &mut Agent,
+    dir: &Path,
+    options: &TrainOptions,
+) -> Result<Vec<EpochMetrics>, TrainError> {
+    let checkpoint_dir = dir.join("checkpoint");
+    let state_path = checkpoint_dir.join("state.json");
+    if !state_path.exists() {
+        return Ok(Vec::new());
+    }
+    let state: TrainState = checkpoint::load_json(&state_path)?;
+    if state.dims != agent.dims || state.config != agent.config {
+        return Err(TrainError::Resume(format!(
+            "{} was trained with other sizes or hyperparameters ({:?}); use a new --out folder",
+            checkpoint_dir.display(),
+            state.dims
+        )));
+    }
+    if state.seed != options.seed {
+        return Err(TrainError::Resume(format!(
+            "{} was trained with seed {}, not {}",
+            checkpoint_dir.display(),
+            state.seed,
+            options.seed
+        )));
+    }
+    let mut networks: [Vec<crate::params::NamedTensor>; 4] = Default::default();
+    for (slot, name) in networks.iter_mut().zip(NETWORK_FILES) {
+        *slot = checkpoint::load_tensors(&checkpoint_dir.join(format!("{name}.safetensors")))?;
+    }
+    agent.load_networks(&networks).map_err(|e| {
+        TrainError::Checkpoint(CheckpointError::Mismatch {
+            path: checkpoint_dir.clone(),
+            message: e.to_string(),
+        })
+    })?;
+    agent.observation_norm = state.observation_norm;
+    agent.goal_norm = state.goal_norm;
+    Ok(state.metrics)
+}
