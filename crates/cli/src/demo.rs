@@ -1,63 +1,100 @@
-//! `dexcube demo`: the project's main job. Until the hand lands, it scrambles a cube at a
-//! move distance, plans the optimal solution and plays it move by move on the net.
+//! `dexcube demo`: the project's main job. The hand solves a scrambled cube with the shipped
+//! policies: the plan is printed, each stage and rollback is narrated as it happens, and the
+//! run ends solved or failed with its action number, optionally as a video.
 
 use std::io::{self, IsTerminal, Write};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use dexcube_cube::{DistanceTable, Position, Solver, format_moves, scrambles_at_distance};
+use dexcube_cube::{DistanceTable, format_moves, scrambles_at_distance};
+use dexcube_operator::Event;
+use dexcube_operator::eval::{resting_point, run_cube};
+use dexcube_sim::render::{DEFAULT_CAMERA, Frame, FrameRenderer, save_video};
+use dexcube_sim::{Scene, SceneKind, Sim};
 
+use crate::eval::PolicyArgs;
 use crate::net;
 
-/// Scrambles a cube, plans an optimal solution and shows it being carried out.
+/// Scrambles a cube and has the hand solve it with the shipped policies.
 #[derive(Args)]
 pub struct DemoArgs {
     /// Move distance of the scramble, 1 to 14 quarter turns.
-    #[arg(long, short, default_value_t = 14, value_parser = clap::value_parser!(u8).range(1..=14))]
+    #[arg(long, short, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=14))]
     distance: u8,
-    /// Seed of the scramble.
+    /// Seed of the scramble and of the rollback's randomisations.
     #[arg(long, short, default_value_t = 0)]
     seed: u64,
+    /// Write a video of the hand: .gif, or .mp4 with ffmpeg installed.
+    #[arg(long)]
+    video: Option<PathBuf>,
+    /// Run the plan open loop, without the rollback mechanism.
+    #[arg(long)]
+    no_rollback: bool,
+    #[command(flatten)]
+    policies: PolicyArgs,
 }
 
 pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
+    let files = args.policies.files()?;
     let colour = io::stdout().is_terminal();
     let table = DistanceTable::build();
     let scramble = scrambles_at_distance(&table, args.distance as usize, 1, args.seed)
         .pop()
         .expect("every distance from 1 to 14 has positions");
-    let plan = table.solve(&Position::of(&scramble.facelets));
     let mut out = io::stdout().lock();
-    writeln!(
-        out,
-        "Scrambled cube at move distance {} (seed {}): {}",
-        args.distance, args.seed, scramble.facelets
-    )?;
+    writeln!(out, "Scrambled cube at move distance {} (seed {}): {}", args.distance, args.seed, scramble.facelets)?;
     write!(out, "{}", net::draw(&scramble.facelets, colour))?;
     writeln!(
         out,
-        "Optimal plan, {} quarter turns: {}\n",
-        plan.len(),
-        format_moves(&plan)
+        "Policies: Stage 1 {} ({} mode), Stage 2 {}; rollback {}",
+        files.rot.display(),
+        files.rot_mode.name(),
+        files.layer.display(),
+        if args.no_rollback { "off" } else { "on" }
     )?;
-    let mut cube = scramble.facelets;
-    for (step, m) in plan.iter().enumerate() {
-        cube = cube.apply(*m);
-        writeln!(out, "{:>2}. {:<2}  {}", step + 1, m.to_string(), cube)?;
-    }
-    write!(out, "\n{}", net::draw(&cube, colour))?;
-    writeln!(
-        out,
-        "{}",
-        if cube.is_solved() {
-            "Solved."
-        } else {
-            "Not solved."
+    let scene = Scene::load(SceneKind::Cube)?;
+    let mut stages = files.load(resting_point()?[2])?;
+    let mut frames: Vec<Frame> = Vec::new();
+    let mut renderer = match &args.video {
+        Some(_) => Some(FrameRenderer::new(&Sim::new(scene.clone()), 480, 360, DEFAULT_CAMERA)?),
+        None => None,
+    };
+    let mut render_error = None;
+    let mut watch = |sim: &mut Sim| {
+        if let Some(r) = renderer.as_mut() {
+            match r.render(sim) {
+                Ok(frame) => frames.push(frame),
+                Err(e) => render_error = Some(e),
+            }
         }
-    )?;
-    Ok(if cube.is_solved() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::FAILURE
-    })
+    };
+    let mut narrate = |event: &Event| {
+        let line = match event {
+            Event::Plan(plan) => format!("Optimal plan, {} quarter turns: {}", plan.len(), format_moves(plan)),
+            Event::Stage1 { face, attempt, ok } => {
+                format!("  Stage 1: bring {face} up (attempt {attempt}) {}", if *ok { "- pose reached" } else { "- pose off" })
+            }
+            Event::Stage2 { turn, of } => format!("  Stage 2: U' on the top layer ({turn} of {of})"),
+            Event::Randomised(why) => format!("  rollback: {why}"),
+            Event::MoveDone(m) => format!("move {m} done"),
+            Event::Replan(plan) => format!("  rollback: the move did not happen; new plan: {}", format_moves(plan)),
+        };
+        let _ = writeln!(io::stdout(), "{line}");
+    };
+    drop(out);
+    let outcome = run_cube(&mut stages, &scene, &table, &scramble.moves, !args.no_rollback, args.seed, &mut watch, &mut narrate);
+    let mut out = io::stdout().lock();
+    match outcome.failure {
+        None => writeln!(out, "Solved with {} atomic actions.", outcome.actions)?,
+        Some(f) => writeln!(out, "Failed ({f:?}) after {} atomic actions.", outcome.actions)?,
+    }
+    writeln!(out, "({} randomisations, {} re-plans, {} control steps)", outcome.randomisations, outcome.replans, outcome.control_steps)?;
+    if let (Some(path), Some(e)) = (&args.video, render_error) {
+        eprintln!("warning: no video written to {}: {e}", path.display());
+    } else if let Some(path) = &args.video {
+        save_video(&frames, 25, path)?;
+        eprintln!("wrote {} ({} frames)", path.display(), frames.len());
+    }
+    Ok(if outcome.solved { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

@@ -7,6 +7,7 @@ mod bench_rl;
 mod bench_sim;
 mod demo;
 mod env;
+mod eval;
 mod net;
 mod render;
 mod solve;
@@ -31,6 +32,8 @@ enum Command {
     Demo(demo::DemoArgs),
     Render(render::RenderArgs),
     Train(train::TrainArgs),
+    Eval(eval::EvalArgs),
+    EvalStage(eval::EvalStageArgs),
     /// Inspects the training environments.
     #[command(subcommand)]
     Env(env::EnvCommand),
@@ -48,6 +51,8 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(args),
         Command::Env(command) => env::run(command),
         Command::Train(args) => train::run(args),
+        Command::Eval(args) => eval::eval(args),
+        Command::EvalStage(args) => eval::eval_stage(args),
         Command::Bench(command) => bench::run(command),
     };
     match outcome {

@@ -117,12 +117,48 @@ fn scramble_is_reproducible_and_its_output_solves_at_that_distance() {
     }
 }
 
+/// The repository's models folder, which the demo and the evaluation use.
+fn models() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
+}
+
 #[test]
-fn demo_solves_its_scramble() {
-    let o = dexcube(&["demo", "--distance", "9", "--seed", "4"], "");
+fn demo_narrates_the_hand_solving_with_the_shipped_policies() {
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let o = dexcube(
+        &["demo", "--distance", "1", "--seed", "3", "--rot-policy", rot.to_str().unwrap(), "--layer-policy", layer.to_str().unwrap()],
+        "",
+    );
+    let out = stdout(&o);
+    assert!(out.contains("Optimal plan, 1 quarter turns"), "{out}");
+    assert!(out.contains("Stage 1: bring") && out.contains("Stage 2: U' on the top layer"), "{out}");
+    let last = out.lines().rev().nth(1).unwrap_or("");
+    assert!(last.starts_with("Solved with") || last.starts_with("Failed ("), "{out}");
+    assert_eq!(o.status.success(), last.starts_with("Solved"), "exit status follows the outcome");
+}
+
+#[test]
+fn demo_without_policies_says_where_to_get_them() {
+    let o = dexcube(&["demo", "--rot-policy", "/no/such/rot"], "");
+    assert_clean_failure(&o, 2, "no policy at /no/such/rot.json");
+}
+
+#[test]
+fn eval_writes_its_table_and_a_rerun_continues_it() {
+    let out = std::env::temp_dir().join("dexcube-cli-eval/table");
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let args = [
+        "eval", "--per-distance", "1", "--distances", "1", "--rollback-only", "--seed", "5", "--threads", "1",
+        "--out", out.to_str().unwrap(), "--rot-policy", rot.to_str().unwrap(), "--layer-policy", layer.to_str().unwrap(),
+    ];
+    let o = dexcube(&args, "");
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stdout(&o).contains("Optimal plan, 9 quarter turns"));
-    assert!(stdout(&o).trim_end().ends_with("Solved."));
+    let csv = std::fs::read_to_string(out.with_extension("csv")).unwrap();
+    assert_eq!(csv.lines().count(), 2, "{csv}");
+    assert!(std::fs::read_to_string(out.with_extension("md")).unwrap().contains("| 1 | 1 |"));
+    let again = dexcube(&args, "");
+    assert!(stderr(&again).contains("0 cubes to go (1 already in"), "{}", stderr(&again));
 }
 
 #[test]

@@ -10,7 +10,9 @@
 //! The goal is one of the paper's three target orientations, each with probability 1/3, at
 //! the resting point. In the cube frame (x = R, y = B, z = U) those targets put U, R and B
 //! on top. The paper names the third the F pose: with F facing -y, a +90° turn about x lifts
-//! B, and turning B on top with U' is B', the same move as F up to a whole-cube turn.
+//! B, and turning B on top with U' is B', the same move as F' up to a whole-cube turn (a face
+//! turn and the opposite face's turn in the same sense, each seen from its own side, move the
+//! layers alike; the paper's "U and D' achieve the same result" means D).
 
 use std::sync::Arc;
 

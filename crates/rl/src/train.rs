@@ -254,6 +254,19 @@ pub fn train<E: GoalEnv>(
             wall_s: wall_before + started.elapsed().as_secs_f64(),
         };
         bar.set_message(format!("test success {:.2}", row.test_success));
+        if options.progress && bar.is_hidden() {
+            // No terminal to draw a bar on (a log file): one line per epoch instead.
+            eprintln!(
+                "{} epoch {}/{}: test success {:.2}, train success {:.2}, {} episodes, {:.0} s",
+                options.label,
+                epoch + 1,
+                options.epochs,
+                row.test_success,
+                row.train_success,
+                row.episodes,
+                row.wall_s
+            );
+        }
         let improved = row.test_success > best;
         best = best.max(row.test_success);
         metrics.push(row);

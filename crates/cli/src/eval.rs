@@ -1,0 +1,307 @@
+//! `dexcube eval` (Table I: the hand solving scrambles at each move distance, with and
+//! without rollback) and `dexcube eval-stage` (each atomic action alone, with a 95% interval).
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+use anyhow::{Context, bail};
+use clap::{Args, ValueEnum};
+use dexcube_cube::{DistanceTable, scrambles_at_distance};
+use dexcube_env::layer::LayerGoals;
+use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotGoal, RotMode};
+use dexcube_operator::eval::{CubeResult, PolicyFiles, markdown, plot, run_cube, table, wilson_interval};
+use dexcube_rl::Policy;
+use dexcube_rl::checkpoint::write_atomically;
+use dexcube_sim::{Scene, SceneKind};
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// The shipped policies, or others.
+#[derive(Args, Clone)]
+pub struct PolicyArgs {
+    /// Stage 1 policy (prefix of NAME.safetensors and NAME.json).
+    #[arg(long, default_value = "models/rot")]
+    pub rot_policy: PathBuf,
+    /// Stage 2 (U') policy.
+    #[arg(long, default_value = "models/layer")]
+    pub layer_policy: PathBuf,
+}
+
+impl PolicyArgs {
+    /// The policy files, checked to exist, with Stage 1's mode read from its card.
+    pub fn files(&self) -> anyhow::Result<PolicyFiles> {
+        for prefix in [&self.rot_policy, &self.layer_policy] {
+            let card = prefix.with_extension("json");
+            if !card.is_file() {
+                bail!(
+                    "no policy at {}: the shipped ones are under models/ (git checkout models), or train one \
+                     with `dexcube train rot --mode axis` / `dexcube train layer --move \"U'\"` and pass its best policy",
+                    card.display()
+                );
+            }
+        }
+        let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(self.rot_policy.with_extension("json"))?)?;
+        let mode = card["metadata"]["environment"]["variant"].as_str().unwrap_or("paper");
+        Ok(PolicyFiles { rot: self.rot_policy.clone(), layer: self.layer_policy.clone(), rot_mode: mode.parse().unwrap_or(RotMode::Paper) })
+    }
+}
+
+/// Solves scrambled cubes with the hand: success rate and action number per move distance.
+#[derive(Args)]
+pub struct EvalArgs {
+    /// Cubes per move distance (the paper: 100).
+    #[arg(long, default_value_t = 100)]
+    per_distance: usize,
+    /// Move distances, e.g. 1-14 or 3,5,7.
+    #[arg(long, default_value = "1-14")]
+    distances: String,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Only the open-loop variant (default: both, rollback first).
+    #[arg(long, conflicts_with = "rollback_only")]
+    no_rollback: bool,
+    /// Only the rollback variant.
+    #[arg(long)]
+    rollback_only: bool,
+    #[arg(long, default_value_t = 2)]
+    threads: usize,
+    /// Output prefix: PREFIX.csv (one row per cube; a rerun continues it), PREFIX.md,
+    /// PREFIX-sr.png, PREFIX-an.png.
+    #[arg(long, default_value = "results/table1")]
+    out: PathBuf,
+    #[command(flatten)]
+    policies: PolicyArgs,
+}
+
+fn parse_distances(text: &str) -> anyhow::Result<Vec<usize>> {
+    let mut out = Vec::new();
+    for part in text.split(',') {
+        let part = part.trim();
+        let range: Vec<&str> = part.split('-').collect();
+        let (lo, hi): (usize, usize) = match range.as_slice() {
+            [one] => (one.parse()?, one.parse()?),
+            [lo, hi] => (lo.parse()?, hi.parse()?),
+            _ => bail!("cannot read move distances '{text}': use e.g. 1-14 or 3,5,7"),
+        };
+        if lo < 1 || hi > 14 || lo > hi {
+            bail!("move distances run from 1 to 14; got '{part}'");
+        }
+        out.extend(lo..=hi);
+    }
+    Ok(out)
+}
+
+pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
+    let distances = parse_distances(&args.distances)?;
+    let files = args.policies.files()?;
+    let variants: Vec<bool> = match (args.no_rollback, args.rollback_only) {
+        (true, _) => vec![false],
+        (_, true) => vec![true],
+        _ => vec![true, false],
+    };
+    let table_all = DistanceTable::build();
+    let csv = args.out.with_extension("csv");
+    let mut results: Vec<CubeResult> = std::fs::read_to_string(&csv)
+        .map(|text| text.lines().skip(1).filter_map(CubeResult::from_csv).collect())
+        .unwrap_or_default();
+    let done: HashSet<(usize, usize, bool)> = results.iter().map(|r| (r.distance, r.index, r.rollback)).collect();
+    let mut jobs = Vec::new();
+    for &rollback in &variants {
+        for &d in &distances {
+            for (i, s) in scrambles_at_distance(&table_all, d, args.per_distance, args.seed).into_iter().enumerate() {
+                if !done.contains(&(d, i, rollback)) {
+                    jobs.push((d, i, rollback, s.moves));
+                }
+            }
+        }
+    }
+    let command = format!(
+        "dexcube eval --per-distance {} --distances {} --seed {}{} --rot-policy {} --layer-policy {}",
+        args.per_distance,
+        args.distances,
+        args.seed,
+        if args.no_rollback { " --no-rollback" } else if args.rollback_only { " --rollback-only" } else { "" },
+        files.rot.display(),
+        files.layer.display()
+    );
+    eprintln!("{} cubes to go ({} already in {})", jobs.len(), results.len(), csv.display());
+    let bar = ProgressBar::new(jobs.len() as u64);
+    bar.set_style(ProgressStyle::with_template("[{elapsed_precise}] {wide_bar} {pos}/{len} cubes, ETA {eta} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let scene = Scene::load(SceneKind::Cube)?;
+    let resting_z = dexcube_operator::eval::resting_point()?[2];
+    let shared = Mutex::new(std::mem::take(&mut results));
+    let next = AtomicUsize::new(0);
+    let jobs = Arc::new(jobs);
+    let save = |results: &[CubeResult]| -> anyhow::Result<()> {
+        let mut sorted = results.to_vec();
+        sorted.sort_by_key(|r| (!r.rollback, r.distance, r.index));
+        let text: Vec<String> = std::iter::once(CubeResult::CSV_HEADER.to_string()).chain(sorted.iter().map(CubeResult::csv_row)).collect();
+        write_atomically(&csv, (text.join("\n") + "\n").as_bytes())?;
+        let rows = table(&sorted, &distances);
+        write_atomically(&args.out.with_extension("md"), markdown(&rows, &command).as_bytes())?;
+        Ok(())
+    };
+    let failures: Mutex<Option<anyhow::Error>> = Mutex::new(None);
+    std::thread::scope(|s| {
+        for _ in 0..args.threads.max(1) {
+            s.spawn(|| {
+                let mut stages = match files.load(resting_z) {
+                    Ok(stages) => stages,
+                    Err(e) => {
+                        failures.lock().expect("lock").replace(e.into());
+                        return;
+                    }
+                };
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some((d, i, rollback, moves)) = jobs.get(k) else { break };
+                    let seed = args.seed ^ ((*d as u64) << 40) ^ ((*i as u64) << 8) ^ (*rollback as u64);
+                    let outcome = run_cube(&mut stages, &scene, &table_all, moves, *rollback, seed, &mut |_| {}, &mut |_| {});
+                    let row = CubeResult {
+                        distance: *d,
+                        index: *i,
+                        rollback: *rollback,
+                        solved: outcome.solved,
+                        actions: outcome.actions,
+                        randomisations: outcome.randomisations,
+                        replans: outcome.replans,
+                        control_steps: outcome.control_steps,
+                        failure: outcome.failure.map_or(String::new(), |f| format!("{f:?}")),
+                    };
+                    let mut all = shared.lock().expect("lock");
+                    all.push(row);
+                    if all.len() % 10 == 0 {
+                        if let Err(e) = save(&all) {
+                            failures.lock().expect("lock").replace(e);
+                        }
+                    }
+                    let solved = all.iter().filter(|r| r.solved).count();
+                    bar.set_message(format!("solved {solved}/{}", all.len()));
+                    bar.inc(1);
+                }
+            });
+        }
+    });
+    bar.finish();
+    if let Some(e) = failures.into_inner().expect("lock") {
+        return Err(e);
+    }
+    let results = shared.into_inner().expect("lock");
+    save(&results)?;
+    let rows = table(&results, &distances);
+    if let Err(e) = plot(&rows, &args.out) {
+        eprintln!("warning: no plot: {e}");
+    }
+    print!("{}", markdown(&rows, &command));
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum StageKind {
+    /// Stage 1: CubeRotEnv with the policy's own success test, the paper's three targets.
+    Rot,
+    /// Stage 2: LayerOpEnv U' with the goal exactly +90°.
+    Layer,
+}
+
+/// Success rate of one atomic action alone, with a 95% confidence interval.
+#[derive(Args)]
+pub struct EvalStageArgs {
+    #[arg(value_enum)]
+    stage: StageKind,
+    #[arg(long, default_value_t = 1000)]
+    episodes: usize,
+    /// Episode i is reset with seed + i.
+    #[arg(long, default_value_t = 1_000_000)]
+    seed: u64,
+    #[arg(long, default_value_t = 2)]
+    threads: usize,
+    #[command(flatten)]
+    policies: PolicyArgs,
+    /// Also write the result into the policy's JSON card, as its evaluation.
+    #[arg(long)]
+    record: bool,
+}
+
+/// Runs a deterministic episode; true if it ends in success.
+fn episode(env: &mut dyn GoalEnv, policy: &Policy, seed: u64) -> bool {
+    let (mut obs, _) = env.reset(Some(seed));
+    loop {
+        let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
+        if t.terminated || t.truncated {
+            return t.info.is_success;
+        }
+        obs = t.observation;
+    }
+}
+
+pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
+    let files = args.policies.files()?;
+    let prefix = match args.stage {
+        StageKind::Rot => files.rot.clone(),
+        StageKind::Layer => files.layer.clone(),
+    };
+    let next = AtomicUsize::new(0);
+    let successes = AtomicUsize::new(0);
+    let bar = ProgressBar::new(args.episodes as u64);
+    let scene = Scene::load(match args.stage {
+        StageKind::Rot => SceneKind::Rot,
+        StageKind::Layer => SceneKind::Layer,
+    })?;
+    std::thread::scope(|s| -> anyhow::Result<()> {
+        let mut handles = Vec::new();
+        for _ in 0..args.threads.max(1) {
+            handles.push(s.spawn(|| -> anyhow::Result<()> {
+                let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
+                let mut env: Box<dyn GoalEnv> = match args.stage {
+                    StageKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(files.rot_mode))),
+                    StageKind::Layer => Box::new(LayerOpEnv::with_scene(scene.clone(), LayerMove::UPrime, LayerGoals::Evaluation)),
+                };
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    if k >= args.episodes {
+                        return Ok(());
+                    }
+                    if episode(env.as_mut(), &policy, args.seed + k as u64) {
+                        successes.fetch_add(1, Ordering::Relaxed);
+                    }
+                    bar.inc(1);
+                }
+            }));
+        }
+        for h in handles {
+            h.join().map_err(|_| anyhow::anyhow!("an evaluation thread panicked"))??;
+        }
+        Ok(())
+    })?;
+    bar.finish_and_clear();
+    let wins = successes.into_inner();
+    let (lo, hi) = wilson_interval(wins, args.episodes);
+    let rate = wins as f64 / args.episodes as f64;
+    let what = match args.stage {
+        StageKind::Rot => format!("Stage 1 (CubeRotEnv, {} mode)", files.rot_mode.name()),
+        StageKind::Layer => "Stage 2 (LayerOpEnv U', goal +90°)".to_string(),
+    };
+    println!("{what}: {wins}/{} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), seed {}, policy {}", args.episodes, args.seed, prefix.display());
+    if args.record {
+        record(&prefix, &args, wins, (lo, hi))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn record(prefix: &Path, args: &EvalStageArgs, successes: usize, (lo, hi): (f64, f64)) -> anyhow::Result<()> {
+    let path = prefix.with_extension("json");
+    let mut card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?).with_context(|| format!("reading {}", path.display()))?;
+    card["metadata"]["evaluation"] = serde_json::json!({
+        "episodes": args.episodes,
+        "successes": successes,
+        "success_rate": successes as f64 / args.episodes as f64,
+        "ci95": [lo, hi],
+        "seed": args.seed,
+        "command": format!("dexcube eval-stage {} --episodes {} --seed {}", match args.stage { StageKind::Rot => "rot", StageKind::Layer => "layer" }, args.episodes, args.seed),
+    });
+    write_atomically(&path, serde_json::to_string_pretty(&card)?.as_bytes())?;
+    Ok(())
+}

@@ -1,0 +1,213 @@
+//! The Rubik's Cube Operator with the paper's rollback mechanism. For each planned move:
+//!
+//! 1. **Stage 1** brings the move's face up (the paper's three target orientations). With
+//!    rollback, the pose is checked; if it is off, the cube is re-seated at a random pose
+//!    and Stage 1 runs again.
+//! 2. **Stage 2** turns the top layer U', once for a primed move, three times otherwise. With
+//!    rollback, the cube is checked for a good state (every layer aligned); if it is not, it
+//!    is restored: its layers are worked back to the nearest quarter turn and it is re-seated
+//!    at a random pose (a simulation shortcut for the paper's "randomisation").
+//! 3. With rollback, the facelets read from the physics are compared with the expected ones;
+//!    if the move did not happen, the operator re-plans from what it sees.
+//!
+//! Without rollback the plan runs open loop. Action number (AN) counts atomic actions, Stage 1
+//! and Stage 2 runs alike; randomisations are counted apart.
+
+use dexcube_cube::{DistanceTable, Face, Facelets, Move, Position, Solver};
+use dexcube_sim::cube::{CubeState, snap_layers};
+use dexcube_sim::{Pose, Sim};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::stages::{Stage1, Stage2, randomise_pose, stage1_target};
+
+/// Why an attempt ended without a solved cube.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Failure {
+    /// The cube fell off the hand.
+    Dropped,
+    /// The physics blew up.
+    Diverged,
+    /// The cube could not be brought to a good state, or its stickers could not be read.
+    StuckMisaligned,
+    /// The action budget ran out.
+    OutOfActions,
+    /// Open loop (no rollback): the plan ran but the cube is not solved.
+    NotSolved,
+}
+
+/// What happened in one attempt.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Outcome {
+    pub solved: bool,
+    pub failure: Option<Failure>,
+    /// Atomic actions run (Stage 1 and Stage 2 runs): the paper's AN.
+    pub actions: usize,
+    pub randomisations: usize,
+    pub replans: usize,
+    pub control_steps: usize,
+}
+
+/// Something the operator did, for narration.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Event {
+    Plan(Vec<Move>),
+    Stage1 { face: Face, attempt: usize, ok: bool },
+    Stage2 { turn: usize, of: usize },
+    Randomised(&'static str),
+    MoveDone(Move),
+    Replan(Vec<Move>),
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct OperatorConfig {
+    pub rollback: bool,
+    /// Atomic actions allowed before giving up.
+    pub max_actions: usize,
+    /// Stage 1 attempts per move (with rollback) before going on anyway.
+    pub stage1_attempts: usize,
+    /// Restores of a misaligned cube per move before giving up.
+    pub restores: usize,
+}
+
+impl Default for OperatorConfig {
+    fn default() -> Self {
+        OperatorConfig { rollback: true, max_actions: 100, stage1_attempts: 3, restores: 2 }
+    }
+}
+
+/// Which face to bring up and how many U' turns make a move (the solver plans in U, R, F).
+pub fn move_plan(m: Move) -> (Face, usize) {
+    let up = match m.face {
+        Face::R => Face::R,
+        // The paper's F pose lifts B. Turning B' on top moves the B layer against the F layer
+        // exactly as F' does (X and its opposite face's X turn the layers the same way
+        // relative to each other), so it serves the F moves.
+        Face::F => Face::B,
+        _ => Face::U,
+    };
+    // One U' on top is U', R' or B' (= F'); three make U, R or F.
+    (up, if m.quarters == 3 { 1 } else { 3 })
+}
+
+pub struct Operator<'a> {
+    pub config: OperatorConfig,
+    pub stage1: &'a mut dyn Stage1,
+    pub stage1_accepts: &'a dyn Fn(&Sim, [f64; 3], [f64; 4]) -> bool,
+    pub stage2: &'a mut dyn Stage2,
+    pub table: &'a DistanceTable,
+    pub resting: [f64; 3],
+    pub rng: ChaCha8Rng,
+    /// Called after every control step, e.g. to record a video.
+    pub watch: &'a mut dyn FnMut(&mut Sim),
+}
+
+impl Operator<'_> {
+    /// Solves the cube in `sim`, reporting each event to `narrate`.
+    pub fn solve(&mut self, sim: &mut Sim, narrate: &mut dyn FnMut(&Event)) -> Outcome {
+        let mut outcome = Outcome { solved: false, failure: None, actions: 0, randomisations: 0, replans: 0, control_steps: 0 };
+        let Some(start) = read(sim) else {
+            outcome.failure = Some(Failure::StuckMisaligned);
+            return outcome;
+        };
+        let mut plan = self.table.solve(&Position::of(&start));
+        narrate(&Event::Plan(plan.clone()));
+        let mut expected = start;
+        while let Some(&m) = plan.first() {
+            if outcome.actions >= self.config.max_actions {
+                outcome.failure = Some(Failure::OutOfActions);
+                return outcome;
+            }
+            if let Some(failure) = self.execute(sim, m, &mut outcome, narrate) {
+                outcome.failure = Some(failure);
+                return outcome;
+            }
+            expected = expected.apply(m);
+            plan.remove(0);
+            if !self.config.rollback {
+                narrate(&Event::MoveDone(m));
+                continue;
+            }
+            // Check that the move happened; if not, re-plan from what is there.
+            match read(sim) {
+                Some(seen) if Position::of(&seen) == Position::of(&expected) => narrate(&Event::MoveDone(m)),
+                Some(seen) => {
+                    plan = self.table.solve(&Position::of(&seen));
+                    expected = seen;
+                    outcome.replans += 1;
+                    narrate(&Event::Replan(plan.clone()));
+                }
+                None => {
+                    outcome.failure = Some(Failure::StuckMisaligned);
+                    return outcome;
+                }
+            }
+        }
+        let solved = CubeState::read(sim).is_some_and(|s| s.is_aligned() && s.facelets_in_cube_frame().is_ok_and(|f| f.is_solved()));
+        outcome.solved = solved;
+        if !solved {
+            outcome.failure = Some(if self.config.rollback { Failure::StuckMisaligned } else { Failure::NotSolved });
+        }
+        outcome
+    }
+
+    /// Both stages of one move, with the rollback checks; a failure ends the attempt.
+    fn execute(&mut self, sim: &mut Sim, m: Move, outcome: &mut Outcome, narrate: &mut dyn FnMut(&Event)) -> Option<Failure> {
+        let (up, turns) = move_plan(m);
+        let target = stage1_target(up);
+        for attempt in 1..=self.config.stage1_attempts {
+            let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
+            outcome.actions += 1;
+            outcome.control_steps += run.steps;
+            if run.dropped || run.diverged {
+                return Some(if run.dropped { Failure::Dropped } else { Failure::Diverged });
+            }
+            let ok = (self.stage1_accepts)(sim, self.resting, target);
+            narrate(&Event::Stage1 { face: up, attempt, ok });
+            if ok || !self.config.rollback || attempt == self.config.stage1_attempts {
+                break;
+            }
+            randomise_pose(sim, self.resting, &mut self.rng);
+            outcome.randomisations += 1;
+            narrate(&Event::Randomised("the pose was off: random pose, then Stage 1 again"));
+        }
+        for turn in 1..=turns {
+            let run = self.stage2.run(sim, &mut *self.watch);
+            outcome.actions += 1;
+            outcome.control_steps += run.steps;
+            narrate(&Event::Stage2 { turn, of: turns });
+            if run.dropped || run.diverged {
+                return Some(if run.dropped { Failure::Dropped } else { Failure::Diverged });
+            }
+            if self.config.rollback {
+                let mut restores = 0;
+                while !CubeState::read(sim).is_some_and(|s| s.is_aligned()) {
+                    if restores == self.config.restores {
+                        return Some(Failure::StuckMisaligned);
+                    }
+                    snap_layers(sim);
+                    randomise_pose(sim, self.resting, &mut self.rng);
+                    restores += 1;
+                    outcome.randomisations += 1;
+                    narrate(&Event::Randomised("not in a good state: layers restored, random pose"));
+                }
+            }
+        }
+        None
+    }
+}
+
+/// The cube's stickers in its own frame, if they can be read.
+fn read(sim: &Sim) -> Option<Facelets> {
+    CubeState::read(sim)?.facelets_in_cube_frame().ok()
+}
+
+/// Places a scrambled cube on the palm: `scramble` turned kinematically from solved, at rest.
+pub fn set_up_scramble(sim: &mut Sim, scramble: &[Move], resting: [f64; 3]) {
+    sim.reset();
+    sim.set_object_pose(&Pose { position: resting, orientation: dexcube_sim::rotation::IDENTITY });
+    for &m in scramble {
+        dexcube_sim::cube::turn_face(sim, m);
+    }
+    sim.forward();
+}

@@ -1,0 +1,222 @@
+//! The two atomic actions as the operator drives them on the physical cube: Stage 1 turns the
+//! whole cube so a face is up, Stage 2 turns the top layer U' by a quarter turn. Each is
+//! either a trained policy (what the paper evaluates) or a kinematic stand-in that sets the
+//! joints directly, for testing the control logic independently of policy quality.
+
+use std::f64::consts::FRAC_PI_2;
+
+use dexcube_cube::Face;
+use dexcube_env::random::uniform_rotation;
+use dexcube_env::{EPISODE_STEPS, Goal, RotGoal, RotMode};
+use dexcube_rl::Policy;
+use dexcube_sim::cube::{CubeState, face_normal, turn_face_by};
+use dexcube_sim::rotation::{self, Quat};
+use dexcube_sim::{HAND_ACTUATORS, Pose, Sim};
+use rand_chacha::ChaCha8Rng;
+
+/// The paper's Stage 1 target orientation for each face that can be brought up, in the cube
+/// frame (x = R, y = B, z = U): U, R, and the pose the paper names F, which lifts B. Turning
+/// B' on top equals F' up to a whole-cube turn, so that pose serves the F moves.
+pub fn stage1_target(up: Face) -> Quat {
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    match up {
+        Face::R => [s, 0.0, -s, 0.0],
+        Face::B => [s, s, 0.0, 0.0],
+        _ => rotation::IDENTITY,
+    }
+}
+
+/// What happens to the cube during one atomic action.
+pub trait Stage1: Send {
+    /// Turns the whole cube so that `target` is its orientation (up to the rotation about
+    /// the vertical in axis mode), resting at `position`. At most 100 control steps.
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun;
+}
+
+pub trait Stage2: Send {
+    /// Turns the layer on top by U' (+90° about the up direction). At most 100 control steps.
+    fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun;
+}
+
+/// Called after every control step of a stage, e.g. to render a frame.
+pub type Watch<'a> = &'a mut dyn FnMut(&mut Sim);
+
+/// How a stage ended.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageRun {
+    pub steps: usize,
+    pub dropped: bool,
+    pub diverged: bool,
+}
+
+/// The cube's observation in the environments' layout: hand angles 24, velocities 24, cube
+/// position 3, orientation 4 (w ≥ 0), velocity 3, angular velocity 3.
+fn base_observation(sim: &Sim) -> Vec<f64> {
+    let pose = sim.object_pose();
+    let (velocity, angular) = sim.object_velocity();
+    let q = pose.orientation;
+    let q = if q[0] < 0.0 { q.map(|x| -x) } else { q };
+    let mut out = Vec::with_capacity(62);
+    out.extend(sim.hand_angles());
+    out.extend(sim.hand_velocities());
+    out.extend(pose.position);
+    out.extend(q);
+    out.extend(velocity);
+    out.extend(angular);
+    out
+}
+
+/// Runs a policy for up to an episode, stopping early when `done` says so.
+fn drive(
+    sim: &mut Sim,
+    mut act: impl FnMut(&Sim) -> Vec<f64>,
+    mut done: impl FnMut(&Sim) -> bool,
+    resting_z: f64,
+    watch: Watch,
+) -> StageRun {
+    let mut run = StageRun::default();
+    for _ in 0..EPISODE_STEPS {
+        if done(sim) {
+            break;
+        }
+        let action = act(sim);
+        let mut clipped = [0.0; HAND_ACTUATORS];
+        for (c, a) in clipped.iter_mut().zip(&action) {
+            *c = a.clamp(-1.0, 1.0);
+        }
+        sim.set_action(&clipped);
+        run.steps += 1;
+        if sim.step().is_err() {
+            run.diverged = true;
+            break;
+        }
+        watch(sim);
+        if sim.object_pose().position[2] < resting_z - dexcube_env::DROP_DEPTH {
+            run.dropped = true;
+            break;
+        }
+    }
+    run
+}
+
+/// Stage 1 by a CubeRotEnv policy.
+pub struct PolicyStage1 {
+    pub policy: Policy,
+    pub mode: RotMode,
+}
+
+impl Stage1 for PolicyStage1 {
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
+        let goal: Vec<f64> = position.iter().chain(target.iter()).copied().collect();
+        let judge = RotGoal::paper(self.mode);
+        let achieved = |sim: &Sim| {
+            let p = sim.object_pose();
+            p.position.iter().chain(p.orientation.iter()).copied().collect::<Vec<f64>>()
+        };
+        let policy = &self.policy;
+        drive(
+            sim,
+            |sim| policy.act(&base_observation(sim), &goal),
+            |sim| judge.is_success(&achieved(sim), &goal),
+            position[2],
+            watch,
+        )
+    }
+}
+
+/// Stage 2 by a LayerOpEnv U' policy. The layer angle is measured from the stage's start,
+/// unwrapped, about the face that is up.
+pub struct PolicyStage2 {
+    pub policy: Policy,
+    pub resting_z: f64,
+}
+
+/// The cube-frame face whose outward normal points most nearly up in the world.
+pub fn face_up(sim: &Sim) -> Face {
+    let q = sim.object_pose().orientation;
+    Face::ALL
+        .into_iter()
+        .max_by(|&a, &b| rotation::rotate(&q, face_normal(a))[2].total_cmp(&rotation::rotate(&q, face_normal(b))[2]))
+        .unwrap_or(Face::U)
+}
+
+impl Stage2 for PolicyStage2 {
+    fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
+        let up = face_up(sim);
+        let read = |sim: &Sim| CubeState::read(sim).map_or(0.0, |s| s.layer_angle(up));
+        let (mut last, mut total) = (read(sim), 0.0);
+        let goal = [FRAC_PI_2];
+        let policy = &self.policy;
+        let mut angle = move |sim: &Sim| {
+            let now = read(sim);
+            // Quarter-turn readings wrap at ±45°: accumulate the change instead.
+            let mut change = now - last;
+            while change > std::f64::consts::FRAC_PI_4 {
+                change -= FRAC_PI_2;
+            }
+            while change < -std::f64::consts::FRAC_PI_4 {
+                change += FRAC_PI_2;
+            }
+            last = now;
+            total += change;
+            total
+        };
+        let latest = std::cell::Cell::new(0.0);
+        drive(
+            sim,
+            |sim| {
+                latest.set(angle(sim));
+                let mut observation = base_observation(sim);
+                observation.push(latest.get());
+                policy.act(&observation, &goal)
+            },
+            |_| (latest.get() - FRAC_PI_2).abs() < 0.1,
+            self.resting_z,
+            watch,
+        )
+    }
+}
+
+/// A perfect Stage 1: sets the cube's orientation, for testing the logic around it.
+pub struct KinematicStage1;
+
+impl Stage1 for KinematicStage1 {
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
+        sim.set_object_pose(&Pose { position, orientation: target });
+        sim.forward();
+        watch(sim);
+        StageRun { steps: 1, ..StageRun::default() }
+    }
+}
+
+/// A Stage 2 that turns the top layer by a set angle (a perfect U' is +90°), for tests.
+pub struct KinematicStage2 {
+    pub angle: f64,
+}
+
+impl Stage2 for KinematicStage2 {
+    fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
+        turn_face_by(sim, Face::U, self.angle);
+        sim.forward();
+        watch(sim);
+        StageRun { steps: 1, ..StageRun::default() }
+    }
+}
+
+/// Re-seats the cube on the palm at a uniformly random orientation, keeping its layers as
+/// they are: the paper's randomisation before Stage 1 is repeated.
+pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
+    sim.set_object_pose(&Pose { position, orientation: uniform_rotation(rng) });
+    sim.forward();
+}
+
+/// The rollback's pose check after Stage 1: CubeRotEnv's success test in `mode`, judged on
+/// the physical cube's pose.
+pub fn pose_reached(mode: RotMode) -> impl Fn(&Sim, [f64; 3], Quat) -> bool {
+    move |sim, position, target| {
+        let p = sim.object_pose();
+        let achieved: Vec<f64> = p.position.iter().chain(p.orientation.iter()).copied().collect();
+        let goal: Vec<f64> = position.iter().chain(target.iter()).copied().collect();
+        RotGoal::paper(mode).is_success(&achieved, &goal)
+    }
+}

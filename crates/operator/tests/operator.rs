@@ -1,0 +1,125 @@
+//! The operator's control logic with real physics and kinematic stages standing in for the
+//! policies: planning, move mapping, readout and completion solve the cube, and each rollback
+//! branch fires on the situation it is for.
+
+use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
+use dexcube_env::RotMode;
+use dexcube_operator::stages::{KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached};
+use dexcube_operator::{Failure, Operator, OperatorConfig, Outcome, move_plan, set_up_scramble};
+use dexcube_sim::rotation::Quat;
+use dexcube_sim::{Scene, SceneKind, Sim};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+const RESTING: [f64; 3] = [1.0, 0.87, 0.2];
+const U_PRIME: f64 = std::f64::consts::FRAC_PI_2;
+
+fn attempt(stage1: &mut dyn Stage1, stage2: &mut dyn Stage2, rollback: bool, distance: usize, seed: u64) -> Outcome {
+    let table = DistanceTable::build();
+    let scramble = scrambles_at_distance(&table, distance, 1, seed).remove(0);
+    let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
+    set_up_scramble(&mut sim, &scramble.moves, RESTING);
+    let accepts = pose_reached(RotMode::Axis);
+    let mut operator = Operator {
+        config: OperatorConfig { rollback, ..OperatorConfig::default() },
+        stage1,
+        stage1_accepts: &accepts,
+        stage2,
+        table: &table,
+        resting: RESTING,
+        rng: ChaCha8Rng::seed_from_u64(seed),
+        watch: &mut |_| {},
+    };
+    operator.solve(&mut sim, &mut |_| {})
+}
+
+#[test]
+fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
+    let table = DistanceTable::build();
+    for (distance, seed) in [(1, 0), (4, 1), (9, 2), (14, 3)] {
+        let outcome = attempt(&mut KinematicStage1, &mut KinematicStage2 { angle: U_PRIME }, true, distance, seed);
+        assert!(outcome.solved, "distance {distance}: {outcome:?}");
+        let plan = table.solve(&dexcube_cube::Position::of(&scrambles_at_distance(&table, distance, 1, seed)[0].facelets));
+        let expected: usize = plan.iter().map(|&m| 1 + move_plan(m).1).sum();
+        assert_eq!(outcome.actions, expected, "one Stage 1 and 1 or 3 Stage 2 runs per move");
+        assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
+    }
+}
+
+/// A Stage 1 that leaves the cube upside down on its first `misses` runs.
+struct MissingStage1 {
+    misses: usize,
+}
+
+impl Stage1 for MissingStage1 {
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
+        if self.misses > 0 {
+            self.misses -= 1;
+            return KinematicStage1.run(sim, position, [0.0, 1.0, 0.0, 0.0], watch);
+        }
+        KinematicStage1.run(sim, position, target, watch)
+    }
+}
+
+#[test]
+fn an_off_pose_after_stage_1_is_randomised_and_retried() {
+    let outcome = attempt(&mut MissingStage1 { misses: 1 }, &mut KinematicStage2 { angle: U_PRIME }, true, 3, 4);
+    assert!(outcome.solved, "{outcome:?}");
+    assert_eq!(outcome.randomisations, 1);
+}
+
+/// A Stage 2 that over-turns by 25° on its first run, then turns right.
+struct SloppyStage2 {
+    sloppy: bool,
+}
+
+impl Stage2 for SloppyStage2 {
+    fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
+        let extra = if std::mem::take(&mut self.sloppy) { 25f64.to_radians() } else { 0.0 };
+        KinematicStage2 { angle: U_PRIME + extra }.run(sim, watch)
+    }
+}
+
+#[test]
+fn a_misaligned_cube_after_stage_2_is_restored_to_a_good_state() {
+    let outcome = attempt(&mut KinematicStage1, &mut SloppyStage2 { sloppy: true }, true, 3, 5);
+    assert!(outcome.solved, "{outcome:?}");
+    assert!(outcome.randomisations >= 1, "{outcome:?}");
+}
+
+/// A Stage 2 that turns the wrong way on its first run.
+struct BackwardsOnce {
+    backwards: bool,
+}
+
+impl Stage2 for BackwardsOnce {
+    fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
+        let sign = if std::mem::take(&mut self.backwards) { -1.0 } else { 1.0 };
+        KinematicStage2 { angle: sign * U_PRIME }.run(sim, watch)
+    }
+}
+
+#[test]
+fn a_move_that_did_not_happen_is_caught_and_replanned() {
+    let outcome = attempt(&mut KinematicStage1, &mut BackwardsOnce { backwards: true }, true, 5, 6);
+    assert!(outcome.solved, "{outcome:?}");
+    assert!(outcome.replans >= 1, "{outcome:?}");
+}
+
+#[test]
+fn without_rollback_the_same_mistake_is_not_recovered() {
+    let outcome = attempt(&mut KinematicStage1, &mut BackwardsOnce { backwards: true }, false, 5, 6);
+    assert!(!outcome.solved);
+    assert_eq!(outcome.failure, Some(Failure::NotSolved));
+    assert_eq!(outcome.replans, 0);
+}
+
+#[test]
+fn a_stage_that_always_turns_backwards_runs_out_of_actions() {
+    // Every requested U' becomes U: primed and plain moves swap, and re-planning chases it.
+    let outcome = attempt(&mut KinematicStage1, &mut KinematicStage2 { angle: -U_PRIME }, true, 6, 7);
+    if !outcome.solved {
+        assert_eq!(outcome.failure, Some(Failure::OutOfActions), "{outcome:?}");
+    }
+    assert!(outcome.actions <= OperatorConfig::default().max_actions + 4);
+}
