@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use clap::Args;
 use dexcube_cube::{DistanceTable, format_moves, scrambles_at_distance};
 use dexcube_operator::Event;
-use dexcube_operator::eval::{resting_point, run_cube};
+use dexcube_operator::eval::{Hooks, resting_point, run_cube};
 use dexcube_sim::render::{DEFAULT_CAMERA, Frame, FrameRenderer, save_video};
 use dexcube_sim::{Scene, SceneKind, Sim};
 
@@ -43,7 +43,11 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         .pop()
         .expect("every distance from 1 to 14 has positions");
     let mut out = io::stdout().lock();
-    writeln!(out, "Scrambled cube at move distance {} (seed {}): {}", args.distance, args.seed, scramble.facelets)?;
+    writeln!(
+        out,
+        "Scrambled cube at move distance {} (seed {}): {}",
+        args.distance, args.seed, scramble.facelets
+    )?;
     write!(out, "{}", net::draw(&scramble.facelets, colour))?;
     writeln!(
         out,
@@ -57,7 +61,12 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     let mut stages = files.load(resting_point()?[2])?;
     let mut frames: Vec<Frame> = Vec::new();
     let mut renderer = match &args.video {
-        Some(_) => Some(FrameRenderer::new(&Sim::new(scene.clone()), 480, 360, DEFAULT_CAMERA)?),
+        Some(_) => Some(FrameRenderer::new(
+            &Sim::new(scene.clone()),
+            480,
+            360,
+            DEFAULT_CAMERA,
+        )?),
         None => None,
     };
     let mut render_error = None;
@@ -71,30 +80,59 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     };
     let mut narrate = |event: &Event| {
         let line = match event {
-            Event::Plan(plan) => format!("Optimal plan, {} quarter turns: {}", plan.len(), format_moves(plan)),
+            Event::Plan(plan) => format!(
+                "Optimal plan, {} quarter turns: {}",
+                plan.len(),
+                format_moves(plan)
+            ),
             Event::Stage1 { face, attempt, ok } => {
-                format!("  Stage 1: bring {face} up (attempt {attempt}) {}", if *ok { "- pose reached" } else { "- pose off" })
+                format!(
+                    "  Stage 1: bring {face} up (attempt {attempt}) {}",
+                    if *ok { "- pose reached" } else { "- pose off" }
+                )
             }
-            Event::Stage2 { turn, of } => format!("  Stage 2: U' on the top layer ({turn} of {of})"),
+            Event::Stage2 { turn, of } => {
+                format!("  Stage 2: U' on the top layer ({turn} of {of})")
+            }
             Event::Randomised(why) => format!("  rollback: {why}"),
             Event::MoveDone(m) => format!("move {m} done"),
-            Event::Replan(plan) => format!("  rollback: the move did not happen; new plan: {}", format_moves(plan)),
+            Event::Replan(plan) => format!(
+                "  rollback: the move did not happen; new plan: {}",
+                format_moves(plan)
+            ),
         };
         let _ = writeln!(io::stdout(), "{line}");
     };
     drop(out);
-    let outcome = run_cube(&mut stages, &scene, &table, &scramble.moves, !args.no_rollback, args.seed, &mut watch, &mut narrate);
+    let hooks = Hooks {
+        watch: &mut watch,
+        narrate: &mut narrate,
+    };
+    let job = (scramble.moves.as_slice(), !args.no_rollback, args.seed);
+    let outcome = run_cube(&mut stages, &scene, &table, job, hooks);
     let mut out = io::stdout().lock();
     match outcome.failure {
         None => writeln!(out, "Solved with {} atomic actions.", outcome.actions)?,
-        Some(f) => writeln!(out, "Failed ({f:?}) after {} atomic actions.", outcome.actions)?,
+        Some(f) => writeln!(
+            out,
+            "Failed ({f:?}) after {} atomic actions.",
+            outcome.actions
+        )?,
     }
-    writeln!(out, "({} randomisations, {} re-plans, {} control steps)", outcome.randomisations, outcome.replans, outcome.control_steps)?;
+    writeln!(
+        out,
+        "({} randomisations, {} re-plans, {} control steps)",
+        outcome.randomisations, outcome.replans, outcome.control_steps
+    )?;
     if let (Some(path), Some(e)) = (&args.video, render_error) {
         eprintln!("warning: no video written to {}: {e}", path.display());
     } else if let Some(path) = &args.video {
         save_video(&frames, 25, path)?;
         eprintln!("wrote {} ({} frames)", path.display(), frames.len());
     }
-    Ok(if outcome.solved { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    Ok(if outcome.solved {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }

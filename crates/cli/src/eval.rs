@@ -12,7 +12,9 @@ use clap::{Args, ValueEnum};
 use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotGoal, RotMode};
-use dexcube_operator::eval::{CubeResult, PolicyFiles, markdown, plot, run_cube, table, wilson_interval};
+use dexcube_operator::eval::{
+    CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
+};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_sim::{Scene, SceneKind};
@@ -42,9 +44,17 @@ impl PolicyArgs {
                 );
             }
         }
-        let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(self.rot_policy.with_extension("json"))?)?;
-        let mode = card["metadata"]["environment"]["variant"].as_str().unwrap_or("paper");
-        Ok(PolicyFiles { rot: self.rot_policy.clone(), layer: self.layer_policy.clone(), rot_mode: mode.parse().unwrap_or(RotMode::Paper) })
+        let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(
+            self.rot_policy.with_extension("json"),
+        )?)?;
+        let mode = card["metadata"]["environment"]["variant"]
+            .as_str()
+            .unwrap_or("paper");
+        Ok(PolicyFiles {
+            rot: self.rot_policy.clone(),
+            layer: self.layer_policy.clone(),
+            rot_mode: mode.parse().unwrap_or(RotMode::Paper),
+        })
     }
 }
 
@@ -104,13 +114,24 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     let table_all = DistanceTable::build();
     let csv = args.out.with_extension("csv");
     let mut results: Vec<CubeResult> = std::fs::read_to_string(&csv)
-        .map(|text| text.lines().skip(1).filter_map(CubeResult::from_csv).collect())
+        .map(|text| {
+            text.lines()
+                .skip(1)
+                .filter_map(CubeResult::from_csv)
+                .collect()
+        })
         .unwrap_or_default();
-    let done: HashSet<(usize, usize, bool)> = results.iter().map(|r| (r.distance, r.index, r.rollback)).collect();
+    let done: HashSet<(usize, usize, bool)> = results
+        .iter()
+        .map(|r| (r.distance, r.index, r.rollback))
+        .collect();
     let mut jobs = Vec::new();
     for &rollback in &variants {
         for &d in &distances {
-            for (i, s) in scrambles_at_distance(&table_all, d, args.per_distance, args.seed).into_iter().enumerate() {
+            for (i, s) in scrambles_at_distance(&table_all, d, args.per_distance, args.seed)
+                .into_iter()
+                .enumerate()
+            {
                 if !done.contains(&(d, i, rollback)) {
                     jobs.push((d, i, rollback, s.moves));
                 }
@@ -122,13 +143,29 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         args.per_distance,
         args.distances,
         args.seed,
-        if args.no_rollback { " --no-rollback" } else if args.rollback_only { " --rollback-only" } else { "" },
+        if args.no_rollback {
+            " --no-rollback"
+        } else if args.rollback_only {
+            " --rollback-only"
+        } else {
+            ""
+        },
         files.rot.display(),
         files.layer.display()
     );
-    eprintln!("{} cubes to go ({} already in {})", jobs.len(), results.len(), csv.display());
+    eprintln!(
+        "{} cubes to go ({} already in {})",
+        jobs.len(),
+        results.len(),
+        csv.display()
+    );
     let bar = ProgressBar::new(jobs.len() as u64);
-    bar.set_style(ProgressStyle::with_template("[{elapsed_precise}] {wide_bar} {pos}/{len} cubes, ETA {eta} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    bar.set_style(
+        ProgressStyle::with_template(
+            "[{elapsed_precise}] {wide_bar} {pos}/{len} cubes, ETA {eta} {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
     let scene = Scene::load(SceneKind::Cube)?;
     let resting_z = dexcube_operator::eval::resting_point()?[2];
     let shared = Mutex::new(std::mem::take(&mut results));
@@ -137,10 +174,15 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     let save = |results: &[CubeResult]| -> anyhow::Result<()> {
         let mut sorted = results.to_vec();
         sorted.sort_by_key(|r| (!r.rollback, r.distance, r.index));
-        let text: Vec<String> = std::iter::once(CubeResult::CSV_HEADER.to_string()).chain(sorted.iter().map(CubeResult::csv_row)).collect();
+        let text: Vec<String> = std::iter::once(CubeResult::CSV_HEADER.to_string())
+            .chain(sorted.iter().map(CubeResult::csv_row))
+            .collect();
         write_atomically(&csv, (text.join("\n") + "\n").as_bytes())?;
         let rows = table(&sorted, &distances);
-        write_atomically(&args.out.with_extension("md"), markdown(&rows, &command).as_bytes())?;
+        write_atomically(
+            &args.out.with_extension("md"),
+            markdown(&rows, &command).as_bytes(),
+        )?;
         Ok(())
     };
     let failures: Mutex<Option<anyhow::Error>> = Mutex::new(None);
@@ -156,9 +198,22 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 };
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some((d, i, rollback, moves)) = jobs.get(k) else { break };
-                    let seed = args.seed ^ ((*d as u64) << 40) ^ ((*i as u64) << 8) ^ (*rollback as u64);
-                    let outcome = run_cube(&mut stages, &scene, &table_all, moves, *rollback, seed, &mut |_| {}, &mut |_| {});
+                    let Some((d, i, rollback, moves)) = jobs.get(k) else {
+                        break;
+                    };
+                    let seed =
+                        args.seed ^ ((*d as u64) << 40) ^ ((*i as u64) << 8) ^ (*rollback as u64);
+                    let hooks = Hooks {
+                        watch: &mut |_| {},
+                        narrate: &mut |_| {},
+                    };
+                    let outcome = run_cube(
+                        &mut stages,
+                        &scene,
+                        &table_all,
+                        (moves, *rollback, seed),
+                        hooks,
+                    );
                     let row = CubeResult {
                         distance: *d,
                         index: *i,
@@ -172,10 +227,10 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                     };
                     let mut all = shared.lock().expect("lock");
                     all.push(row);
-                    if all.len() % 10 == 0 {
-                        if let Err(e) = save(&all) {
-                            failures.lock().expect("lock").replace(e);
-                        }
+                    // Every finished cube is on disk at once: a killed run loses at most the
+                    // cubes under way.
+                    if let Err(e) = save(&all) {
+                        failures.lock().expect("lock").replace(e);
                     }
                     let solved = all.iter().filter(|r| r.solved).count();
                     bar.set_message(format!("solved {solved}/{}", all.len()));
@@ -256,8 +311,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             handles.push(s.spawn(|| -> anyhow::Result<()> {
                 let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
                 let mut env: Box<dyn GoalEnv> = match args.stage {
-                    StageKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(files.rot_mode))),
-                    StageKind::Layer => Box::new(LayerOpEnv::with_scene(scene.clone(), LayerMove::UPrime, LayerGoals::Evaluation)),
+                    StageKind::Rot => Box::new(CubeRotEnv::with_scene(
+                        scene.clone(),
+                        RotGoal::paper(files.rot_mode),
+                    )),
+                    StageKind::Layer => Box::new(LayerOpEnv::with_scene(
+                        scene.clone(),
+                        LayerMove::UPrime,
+                        LayerGoals::Evaluation,
+                    )),
                 };
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);
@@ -272,7 +334,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             }));
         }
         for h in handles {
-            h.join().map_err(|_| anyhow::anyhow!("an evaluation thread panicked"))??;
+            h.join()
+                .map_err(|_| anyhow::anyhow!("an evaluation thread panicked"))??;
         }
         Ok(())
     })?;
@@ -284,16 +347,27 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         StageKind::Rot => format!("Stage 1 (CubeRotEnv, {} mode)", files.rot_mode.name()),
         StageKind::Layer => "Stage 2 (LayerOpEnv U', goal +90°)".to_string(),
     };
-    println!("{what}: {wins}/{} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), seed {}, policy {}", args.episodes, args.seed, prefix.display());
+    println!(
+        "{what}: {wins}/{} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), seed {}, policy {}",
+        args.episodes,
+        args.seed,
+        prefix.display()
+    );
     if args.record {
         record(&prefix, &args, wins, (lo, hi))?;
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn record(prefix: &Path, args: &EvalStageArgs, successes: usize, (lo, hi): (f64, f64)) -> anyhow::Result<()> {
+fn record(
+    prefix: &Path,
+    args: &EvalStageArgs,
+    successes: usize,
+    (lo, hi): (f64, f64),
+) -> anyhow::Result<()> {
     let path = prefix.with_extension("json");
-    let mut card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?).with_context(|| format!("reading {}", path.display()))?;
+    let mut card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
+        .with_context(|| format!("reading {}", path.display()))?;
     card["metadata"]["evaluation"] = serde_json::json!({
         "episodes": args.episodes,
         "successes": successes,

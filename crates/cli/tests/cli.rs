@@ -126,15 +126,35 @@ fn models() -> std::path::PathBuf {
 fn demo_narrates_the_hand_solving_with_the_shipped_policies() {
     let (rot, layer) = (models().join("rot"), models().join("layer"));
     let o = dexcube(
-        &["demo", "--distance", "1", "--seed", "3", "--rot-policy", rot.to_str().unwrap(), "--layer-policy", layer.to_str().unwrap()],
+        &[
+            "demo",
+            "--distance",
+            "1",
+            "--seed",
+            "3",
+            "--rot-policy",
+            rot.to_str().unwrap(),
+            "--layer-policy",
+            layer.to_str().unwrap(),
+        ],
         "",
     );
     let out = stdout(&o);
     assert!(out.contains("Optimal plan, 1 quarter turns"), "{out}");
-    assert!(out.contains("Stage 1: bring") && out.contains("Stage 2: U' on the top layer"), "{out}");
+    assert!(
+        out.contains("Stage 1: bring") && out.contains("Stage 2: U' on the top layer"),
+        "{out}"
+    );
     let last = out.lines().rev().nth(1).unwrap_or("");
-    assert!(last.starts_with("Solved with") || last.starts_with("Failed ("), "{out}");
-    assert_eq!(o.status.success(), last.starts_with("Solved"), "exit status follows the outcome");
+    assert!(
+        last.starts_with("Solved with") || last.starts_with("Failed ("),
+        "{out}"
+    );
+    assert_eq!(
+        o.status.success(),
+        last.starts_with("Solved"),
+        "exit status follows the outcome"
+    );
 }
 
 #[test]
@@ -149,16 +169,38 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
     let (rot, layer) = (models().join("rot"), models().join("layer"));
     let args = [
-        "eval", "--per-distance", "1", "--distances", "1", "--rollback-only", "--seed", "5", "--threads", "1",
-        "--out", out.to_str().unwrap(), "--rot-policy", rot.to_str().unwrap(), "--layer-policy", layer.to_str().unwrap(),
+        "eval",
+        "--per-distance",
+        "1",
+        "--distances",
+        "1",
+        "--rollback-only",
+        "--seed",
+        "5",
+        "--threads",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+        "--rot-policy",
+        rot.to_str().unwrap(),
+        "--layer-policy",
+        layer.to_str().unwrap(),
     ];
     let o = dexcube(&args, "");
     assert!(o.status.success(), "{}", stderr(&o));
     let csv = std::fs::read_to_string(out.with_extension("csv")).unwrap();
     assert_eq!(csv.lines().count(), 2, "{csv}");
-    assert!(std::fs::read_to_string(out.with_extension("md")).unwrap().contains("| 1 | 1 |"));
+    assert!(
+        std::fs::read_to_string(out.with_extension("md"))
+            .unwrap()
+            .contains("| 1 | 1 |")
+    );
     let again = dexcube(&args, "");
-    assert!(stderr(&again).contains("0 cubes to go (1 already in"), "{}", stderr(&again));
+    assert!(
+        stderr(&again).contains("0 cubes to go (1 already in"),
+        "{}",
+        stderr(&again)
+    );
 }
 
 #[test]

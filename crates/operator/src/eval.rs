@@ -18,10 +18,18 @@ use crate::operator::{Operator, OperatorConfig, set_up_scramble};
 use crate::stages::{PolicyStage1, PolicyStage2, pose_reached};
 
 /// The paper's Table I, move distances 1 to 14.
-pub const PAPER_SR_ROLLBACK: [f64; 14] = [1.0, 1.0, 0.95, 0.95, 0.89, 0.95, 0.94, 0.86, 0.85, 0.89, 0.8, 0.8, 0.88, 0.88];
-pub const PAPER_SR_OPEN_LOOP: [f64; 14] = [0.93, 0.83, 0.82, 0.74, 0.72, 0.62, 0.46, 0.43, 0.42, 0.43, 0.34, 0.41, 0.37, 0.46];
-pub const PAPER_AN_ROLLBACK: [f64; 14] = [4.8, 9.11, 11.49, 14.80, 18.04, 22.22, 26.87, 28.39, 34.91, 36.94, 41.0, 41.0, 41.81, 39.65];
-pub const PAPER_AN_OPEN_LOOP: [f64; 14] = [4.81, 6.07, 9.90, 12.81, 15.22, 19.55, 21.57, 25.11, 26.06, 29.95, 34.2, 34.15, 34.65, 32.60];
+pub const PAPER_SR_ROLLBACK: [f64; 14] = [
+    1.0, 1.0, 0.95, 0.95, 0.89, 0.95, 0.94, 0.86, 0.85, 0.89, 0.8, 0.8, 0.88, 0.88,
+];
+pub const PAPER_SR_OPEN_LOOP: [f64; 14] = [
+    0.93, 0.83, 0.82, 0.74, 0.72, 0.62, 0.46, 0.43, 0.42, 0.43, 0.34, 0.41, 0.37, 0.46,
+];
+pub const PAPER_AN_ROLLBACK: [f64; 14] = [
+    4.8, 9.11, 11.49, 14.80, 18.04, 22.22, 26.87, 28.39, 34.91, 36.94, 41.0, 41.0, 41.81, 39.65,
+];
+pub const PAPER_AN_OPEN_LOOP: [f64; 14] = [
+    4.81, 6.07, 9.90, 12.81, 15.22, 19.55, 21.57, 25.11, 26.06, 29.95, 34.2, 34.15, 34.65, 32.60,
+];
 
 /// Where the two policies are, and how Stage 1's pose is judged.
 #[derive(Clone, Debug)]
@@ -42,8 +50,14 @@ impl PolicyFiles {
     pub fn load(&self, resting_z: f64) -> Result<LoadedStages, CheckpointError> {
         let device = Device::flex();
         Ok(LoadedStages {
-            stage1: PolicyStage1 { policy: Policy::load(&self.rot, &device)?, mode: self.rot_mode },
-            stage2: PolicyStage2 { policy: Policy::load(&self.layer, &device)?, resting_z },
+            stage1: PolicyStage1 {
+                policy: Policy::load(&self.rot, &device)?,
+                mode: self.rot_mode,
+            },
+            stage2: PolicyStage2 {
+                policy: Policy::load(&self.layer, &device)?,
+                resting_z,
+            },
             rot_mode: self.rot_mode,
         })
     }
@@ -64,12 +78,21 @@ pub struct CubeResult {
 }
 
 impl CubeResult {
-    pub const CSV_HEADER: &'static str = "distance,index,rollback,solved,actions,randomisations,replans,control_steps,failure";
+    pub const CSV_HEADER: &'static str =
+        "distance,index,rollback,solved,actions,randomisations,replans,control_steps,failure";
 
     pub fn csv_row(&self) -> String {
         format!(
             "{},{},{},{},{},{},{},{},{}",
-            self.distance, self.index, self.rollback, self.solved, self.actions, self.randomisations, self.replans, self.control_steps, self.failure
+            self.distance,
+            self.index,
+            self.rollback,
+            self.solved,
+            self.actions,
+            self.randomisations,
+            self.replans,
+            self.control_steps,
+            self.failure
         )
     }
 
@@ -92,38 +115,46 @@ impl CubeResult {
     }
 }
 
+/// Callbacks while a cube is solved: after every control step, and at every event.
+pub struct Hooks<'a> {
+    pub watch: &'a mut dyn FnMut(&mut Sim),
+    pub narrate: &'a mut dyn FnMut(&crate::Event),
+}
+
 /// Solves one scrambled cube with the hand. The cube is made from `scramble` on the palm;
 /// `seed` drives the rollback's randomisations.
 pub fn run_cube(
     stages: &mut LoadedStages,
     scene: &std::sync::Arc<Scene>,
     table: &DistanceTable,
-    scramble: &[Move],
-    rollback: bool,
-    seed: u64,
-    watch: &mut dyn FnMut(&mut Sim),
-    narrate: &mut dyn FnMut(&crate::Event),
+    (scramble, rollback, seed): (&[Move], bool, u64),
+    hooks: Hooks,
 ) -> crate::Outcome {
     let mut sim = Sim::new(scene.clone());
     let resting = sim.object_pose().position;
     set_up_scramble(&mut sim, scramble, resting);
     let accepts = pose_reached(stages.rot_mode);
     let mut operator = Operator {
-        config: OperatorConfig { rollback, ..OperatorConfig::default() },
+        config: OperatorConfig {
+            rollback,
+            ..OperatorConfig::default()
+        },
         stage1: &mut stages.stage1,
         stage1_accepts: &accepts,
         stage2: &mut stages.stage2,
         table,
         resting,
         rng: ChaCha8Rng::seed_from_u64(seed),
-        watch,
+        watch: hooks.watch,
     };
-    operator.solve(&mut sim, narrate)
+    operator.solve(&mut sim, hooks.narrate)
 }
 
 /// The cube scene's resting point: where the cube starts on the palm.
 pub fn resting_point() -> Result<[f64; 3], dexcube_sim::SimError> {
-    Ok(Sim::new(Scene::load(SceneKind::Cube)?).object_pose().position)
+    Ok(Sim::new(Scene::load(SceneKind::Cube)?)
+        .object_pose()
+        .position)
 }
 
 /// One row of Table I.
@@ -141,7 +172,10 @@ pub struct TableRow {
 /// Success rate and mean action number (over all cubes, solved or not) per distance.
 pub fn table(results: &[CubeResult], distances: &[usize]) -> Vec<TableRow> {
     let summary = |d: usize, rollback: bool| {
-        let rows: Vec<&CubeResult> = results.iter().filter(|r| r.distance == d && r.rollback == rollback).collect();
+        let rows: Vec<&CubeResult> = results
+            .iter()
+            .filter(|r| r.distance == d && r.rollback == rollback)
+            .collect();
         let n = rows.len();
         let sr = rows.iter().filter(|r| r.solved).count() as f64 / n.max(1) as f64;
         let an = rows.iter().map(|r| r.actions as f64).sum::<f64>() / n.max(1) as f64;
@@ -152,15 +186,31 @@ pub fn table(results: &[CubeResult], distances: &[usize]) -> Vec<TableRow> {
         .map(|&d| {
             let (cubes_rollback, sr_rollback, an_rollback) = summary(d, true);
             let (cubes_open_loop, sr_open_loop, an_open_loop) = summary(d, false);
-            TableRow { distance: d, cubes_rollback, sr_rollback, an_rollback, cubes_open_loop, sr_open_loop, an_open_loop }
+            TableRow {
+                distance: d,
+                cubes_rollback,
+                sr_rollback,
+                an_rollback,
+                cubes_open_loop,
+                sr_open_loop,
+                an_open_loop,
+            }
         })
         .collect()
 }
 
 /// Table I as markdown, ours beside the paper's.
 pub fn markdown(rows: &[TableRow], command: &str) -> String {
-    let cell = |n: usize, x: f64, digits: usize| if n == 0 { "-".to_string() } else { format!("{x:.digits$}") };
-    let mut out = format!("Produced by `{command}`.\n\n| move distance | cubes | SR rollback | SR rollback (paper) | AN rollback | AN rollback (paper) | SR open loop | SR open loop (paper) | AN open loop | AN open loop (paper) |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    let cell = |n: usize, x: f64, digits: usize| {
+        if n == 0 {
+            "-".to_string()
+        } else {
+            format!("{x:.digits$}")
+        }
+    };
+    let mut out = format!(
+        "Produced by `{command}`.\n\n| move distance | cubes | SR rollback | SR rollback (paper) | AN rollback | AN rollback (paper) | SR open loop | SR open loop (paper) | AN open loop | AN open loop (paper) |\n|---|---|---|---|---|---|---|---|---|---|\n"
+    );
     for r in rows {
         let k = r.distance - 1;
         out += &format!(
@@ -183,21 +233,84 @@ pub fn markdown(rows: &[TableRow], command: &str) -> String {
 /// Draws SR and AN against move distance, ours and the paper's, into a PNG.
 pub fn plot(rows: &[TableRow], path: &Path) -> Result<(), String> {
     use dexcube_rl::plot::{Series, line_plot};
-    let series = |f: &dyn Fn(&TableRow) -> f64, paper: &[f64; 14], label: &str, want: &dyn Fn(&TableRow) -> bool| {
+    let series = |f: &dyn Fn(&TableRow) -> f64,
+                  paper: &[f64; 14],
+                  label: &str,
+                  want: &dyn Fn(&TableRow) -> bool| {
         [
-            Series { label: format!("{label} (ours)"), points: rows.iter().filter(|r| want(r)).map(|r| (r.distance as f64, f(r))).collect(), band: None },
-            Series { label: format!("{label} (paper)"), points: rows.iter().map(|r| (r.distance as f64, paper[r.distance - 1])).collect(), band: None },
+            Series {
+                label: format!("{label} (ours)"),
+                points: rows
+                    .iter()
+                    .filter(|r| want(r))
+                    .map(|r| (r.distance as f64, f(r)))
+                    .collect(),
+                band: None,
+            },
+            Series {
+                label: format!("{label} (paper)"),
+                points: rows
+                    .iter()
+                    .map(|r| (r.distance as f64, paper[r.distance - 1]))
+                    .collect(),
+                band: None,
+            },
         ]
     };
-    let mut sr: Vec<Series> = series(&|r| r.sr_rollback, &PAPER_SR_ROLLBACK, "SR rollback", &|r| r.cubes_rollback > 0).into();
-    sr.extend(series(&|r| r.sr_open_loop, &PAPER_SR_OPEN_LOOP, "SR open loop", &|r| r.cubes_open_loop > 0));
-    let sr_path = path.with_file_name(format!("{}-sr.png", path.file_stem().and_then(|s| s.to_str()).unwrap_or("table")));
-    line_plot(&sr_path, "Success rate by move distance", "move distance", "success rate", 1.05, &sr)?;
-    let mut an: Vec<Series> = series(&|r| r.an_rollback, &PAPER_AN_ROLLBACK, "AN rollback", &|r| r.cubes_rollback > 0).into();
-    an.extend(series(&|r| r.an_open_loop, &PAPER_AN_OPEN_LOOP, "AN open loop", &|r| r.cubes_open_loop > 0));
-    let an_max = rows.iter().map(|r| r.an_rollback.max(r.an_open_loop)).fold(45.0, f64::max);
-    let an_path = path.with_file_name(format!("{}-an.png", path.file_stem().and_then(|s| s.to_str()).unwrap_or("table")));
-    line_plot(&an_path, "Action number by move distance", "move distance", "atomic actions", an_max * 1.05, &an)
+    let mut sr: Vec<Series> = series(
+        &|r| r.sr_rollback,
+        &PAPER_SR_ROLLBACK,
+        "SR rollback",
+        &|r| r.cubes_rollback > 0,
+    )
+    .into();
+    sr.extend(series(
+        &|r| r.sr_open_loop,
+        &PAPER_SR_OPEN_LOOP,
+        "SR open loop",
+        &|r| r.cubes_open_loop > 0,
+    ));
+    let sr_path = path.with_file_name(format!(
+        "{}-sr.png",
+        path.file_stem().and_then(|s| s.to_str()).unwrap_or("table")
+    ));
+    line_plot(
+        &sr_path,
+        "Success rate by move distance",
+        "move distance",
+        "success rate",
+        1.05,
+        &sr,
+    )?;
+    let mut an: Vec<Series> = series(
+        &|r| r.an_rollback,
+        &PAPER_AN_ROLLBACK,
+        "AN rollback",
+        &|r| r.cubes_rollback > 0,
+    )
+    .into();
+    an.extend(series(
+        &|r| r.an_open_loop,
+        &PAPER_AN_OPEN_LOOP,
+        "AN open loop",
+        &|r| r.cubes_open_loop > 0,
+    ));
+    let an_max = rows
+        .iter()
+        .map(|r| r.an_rollback.max(r.an_open_loop))
+        .fold(45.0, f64::max);
+    let an_path = path.with_file_name(format!(
+        "{}-an.png",
+        path.file_stem().and_then(|s| s.to_str()).unwrap_or("table")
+    ));
+    line_plot(
+        &an_path,
+        "Action number by move distance",
+        "move distance",
+        "atomic actions",
+        an_max * 1.05,
+        &an,
+    )
 }
 
 /// The 95% Wilson score interval of a success rate.
@@ -218,7 +331,10 @@ mod tests {
     #[test]
     fn wilson_interval_matches_known_values() {
         let (lo, hi) = wilson_interval(952, 1000);
-        assert!((lo - 0.9372).abs() < 1e-3 && (hi - 0.9636).abs() < 1e-3, "{lo} {hi}");
+        assert!(
+            (lo - 0.9372).abs() < 1e-3 && (hi - 0.9636).abs() < 1e-3,
+            "{lo} {hi}"
+        );
         assert_eq!(wilson_interval(0, 0), (0.0, 1.0));
     }
 
@@ -235,8 +351,22 @@ mod tests {
             control_steps: 0,
             failure: String::new(),
         };
-        let rows = table(&[r(1, true, true, 2), r(1, true, false, 6), r(1, false, true, 2)], &[1, 2]);
-        assert_eq!((rows[0].cubes_rollback, rows[0].sr_rollback, rows[0].an_rollback), (2, 0.5, 4.0));
+        let rows = table(
+            &[
+                r(1, true, true, 2),
+                r(1, true, false, 6),
+                r(1, false, true, 2),
+            ],
+            &[1, 2],
+        );
+        assert_eq!(
+            (
+                rows[0].cubes_rollback,
+                rows[0].sr_rollback,
+                rows[0].an_rollback
+            ),
+            (2, 0.5, 4.0)
+        );
         assert_eq!((rows[0].cubes_open_loop, rows[0].sr_open_loop), (1, 1.0));
         assert_eq!(rows[1].cubes_rollback, 0);
         let line = r(3, false, true, 9).csv_row();

@@ -52,8 +52,15 @@ pub struct Outcome {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Event {
     Plan(Vec<Move>),
-    Stage1 { face: Face, attempt: usize, ok: bool },
-    Stage2 { turn: usize, of: usize },
+    Stage1 {
+        face: Face,
+        attempt: usize,
+        ok: bool,
+    },
+    Stage2 {
+        turn: usize,
+        of: usize,
+    },
     Randomised(&'static str),
     MoveDone(Move),
     Replan(Vec<Move>),
@@ -72,7 +79,12 @@ pub struct OperatorConfig {
 
 impl Default for OperatorConfig {
     fn default() -> Self {
-        OperatorConfig { rollback: true, max_actions: 100, stage1_attempts: 3, restores: 2 }
+        OperatorConfig {
+            rollback: true,
+            max_actions: 100,
+            stage1_attempts: 3,
+            restores: 2,
+        }
     }
 }
 
@@ -90,10 +102,14 @@ pub fn move_plan(m: Move) -> (Face, usize) {
     (up, if m.quarters == 3 { 1 } else { 3 })
 }
 
+/// The rollback's test of the cube's pose after Stage 1: (simulation, target position, target
+/// orientation) -> reached.
+pub type PoseCheck = dyn Fn(&Sim, [f64; 3], [f64; 4]) -> bool;
+
 pub struct Operator<'a> {
     pub config: OperatorConfig,
     pub stage1: &'a mut dyn Stage1,
-    pub stage1_accepts: &'a dyn Fn(&Sim, [f64; 3], [f64; 4]) -> bool,
+    pub stage1_accepts: &'a PoseCheck,
     pub stage2: &'a mut dyn Stage2,
     pub table: &'a DistanceTable,
     pub resting: [f64; 3],
@@ -105,7 +121,14 @@ pub struct Operator<'a> {
 impl Operator<'_> {
     /// Solves the cube in `sim`, reporting each event to `narrate`.
     pub fn solve(&mut self, sim: &mut Sim, narrate: &mut dyn FnMut(&Event)) -> Outcome {
-        let mut outcome = Outcome { solved: false, failure: None, actions: 0, randomisations: 0, replans: 0, control_steps: 0 };
+        let mut outcome = Outcome {
+            solved: false,
+            failure: None,
+            actions: 0,
+            randomisations: 0,
+            replans: 0,
+            control_steps: 0,
+        };
         let Some(start) = read(sim) else {
             outcome.failure = Some(Failure::StuckMisaligned);
             return outcome;
@@ -130,7 +153,9 @@ impl Operator<'_> {
             }
             // Check that the move happened; if not, re-plan from what is there.
             match read(sim) {
-                Some(seen) if Position::of(&seen) == Position::of(&expected) => narrate(&Event::MoveDone(m)),
+                Some(seen) if Position::of(&seen) == Position::of(&expected) => {
+                    narrate(&Event::MoveDone(m))
+                }
                 Some(seen) => {
                     plan = self.table.solve(&Position::of(&seen));
                     expected = seen;
@@ -143,16 +168,28 @@ impl Operator<'_> {
                 }
             }
         }
-        let solved = CubeState::read(sim).is_some_and(|s| s.is_aligned() && s.facelets_in_cube_frame().is_ok_and(|f| f.is_solved()));
+        let solved = CubeState::read(sim).is_some_and(|s| {
+            s.is_aligned() && s.facelets_in_cube_frame().is_ok_and(|f| f.is_solved())
+        });
         outcome.solved = solved;
         if !solved {
-            outcome.failure = Some(if self.config.rollback { Failure::StuckMisaligned } else { Failure::NotSolved });
+            outcome.failure = Some(if self.config.rollback {
+                Failure::StuckMisaligned
+            } else {
+                Failure::NotSolved
+            });
         }
         outcome
     }
 
     /// Both stages of one move, with the rollback checks; a failure ends the attempt.
-    fn execute(&mut self, sim: &mut Sim, m: Move, outcome: &mut Outcome, narrate: &mut dyn FnMut(&Event)) -> Option<Failure> {
+    fn execute(
+        &mut self,
+        sim: &mut Sim,
+        m: Move,
+        outcome: &mut Outcome,
+        narrate: &mut dyn FnMut(&Event),
+    ) -> Option<Failure> {
         let (up, turns) = move_plan(m);
         let target = stage1_target(up);
         for attempt in 1..=self.config.stage1_attempts {
@@ -160,16 +197,26 @@ impl Operator<'_> {
             outcome.actions += 1;
             outcome.control_steps += run.steps;
             if run.dropped || run.diverged {
-                return Some(if run.dropped { Failure::Dropped } else { Failure::Diverged });
+                return Some(if run.dropped {
+                    Failure::Dropped
+                } else {
+                    Failure::Diverged
+                });
             }
             let ok = (self.stage1_accepts)(sim, self.resting, target);
-            narrate(&Event::Stage1 { face: up, attempt, ok });
+            narrate(&Event::Stage1 {
+                face: up,
+                attempt,
+                ok,
+            });
             if ok || !self.config.rollback || attempt == self.config.stage1_attempts {
                 break;
             }
             randomise_pose(sim, self.resting, &mut self.rng);
             outcome.randomisations += 1;
-            narrate(&Event::Randomised("the pose was off: random pose, then Stage 1 again"));
+            narrate(&Event::Randomised(
+                "the pose was off: random pose, then Stage 1 again",
+            ));
         }
         for turn in 1..=turns {
             let run = self.stage2.run(sim, &mut *self.watch);
@@ -177,7 +224,11 @@ impl Operator<'_> {
             outcome.control_steps += run.steps;
             narrate(&Event::Stage2 { turn, of: turns });
             if run.dropped || run.diverged {
-                return Some(if run.dropped { Failure::Dropped } else { Failure::Diverged });
+                return Some(if run.dropped {
+                    Failure::Dropped
+                } else {
+                    Failure::Diverged
+                });
             }
             if self.config.rollback {
                 let mut restores = 0;
@@ -189,7 +240,9 @@ impl Operator<'_> {
                     randomise_pose(sim, self.resting, &mut self.rng);
                     restores += 1;
                     outcome.randomisations += 1;
-                    narrate(&Event::Randomised("not in a good state: layers restored, random pose"));
+                    narrate(&Event::Randomised(
+                        "not in a good state: layers restored, random pose",
+                    ));
                 }
             }
         }
@@ -205,7 +258,10 @@ fn read(sim: &Sim) -> Option<Facelets> {
 /// Places a scrambled cube on the palm: `scramble` turned kinematically from solved, at rest.
 pub fn set_up_scramble(sim: &mut Sim, scramble: &[Move], resting: [f64; 3]) {
     sim.reset();
-    sim.set_object_pose(&Pose { position: resting, orientation: dexcube_sim::rotation::IDENTITY });
+    sim.set_object_pose(&Pose {
+        position: resting,
+        orientation: dexcube_sim::rotation::IDENTITY,
+    });
     for &m in scramble {
         dexcube_sim::cube::turn_face(sim, m);
     }

@@ -111,7 +111,11 @@ impl Stage1 for PolicyStage1 {
         let judge = RotGoal::paper(self.mode);
         let achieved = |sim: &Sim| {
             let p = sim.object_pose();
-            p.position.iter().chain(p.orientation.iter()).copied().collect::<Vec<f64>>()
+            p.position
+                .iter()
+                .chain(p.orientation.iter())
+                .copied()
+                .collect::<Vec<f64>>()
         };
         let policy = &self.policy;
         drive(
@@ -136,7 +140,10 @@ pub fn face_up(sim: &Sim) -> Face {
     let q = sim.object_pose().orientation;
     Face::ALL
         .into_iter()
-        .max_by(|&a, &b| rotation::rotate(&q, face_normal(a))[2].total_cmp(&rotation::rotate(&q, face_normal(b))[2]))
+        .max_by(|&a, &b| {
+            rotation::rotate(&q, face_normal(a))[2]
+                .total_cmp(&rotation::rotate(&q, face_normal(b))[2])
+        })
         .unwrap_or(Face::U)
 }
 
@@ -182,10 +189,16 @@ pub struct KinematicStage1;
 
 impl Stage1 for KinematicStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
-        sim.set_object_pose(&Pose { position, orientation: target });
+        sim.set_object_pose(&Pose {
+            position,
+            orientation: target,
+        });
         sim.forward();
         watch(sim);
-        StageRun { steps: 1, ..StageRun::default() }
+        StageRun {
+            steps: 1,
+            ..StageRun::default()
+        }
     }
 }
 
@@ -199,14 +212,20 @@ impl Stage2 for KinematicStage2 {
         turn_face_by(sim, Face::U, self.angle);
         sim.forward();
         watch(sim);
-        StageRun { steps: 1, ..StageRun::default() }
+        StageRun {
+            steps: 1,
+            ..StageRun::default()
+        }
     }
 }
 
 /// Re-seats the cube on the palm at a uniformly random orientation, keeping its layers as
 /// they are: the paper's randomisation before Stage 1 is repeated.
 pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
-    sim.set_object_pose(&Pose { position, orientation: uniform_rotation(rng) });
+    sim.set_object_pose(&Pose {
+        position,
+        orientation: uniform_rotation(rng),
+    });
     sim.forward();
 }
 
@@ -215,7 +234,12 @@ pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
 pub fn pose_reached(mode: RotMode) -> impl Fn(&Sim, [f64; 3], Quat) -> bool {
     move |sim, position, target| {
         let p = sim.object_pose();
-        let achieved: Vec<f64> = p.position.iter().chain(p.orientation.iter()).copied().collect();
+        let achieved: Vec<f64> = p
+            .position
+            .iter()
+            .chain(p.orientation.iter())
+            .copied()
+            .collect();
         let goal: Vec<f64> = position.iter().chain(target.iter()).copied().collect();
         RotGoal::paper(mode).is_success(&achieved, &goal)
     }

@@ -4,7 +4,9 @@
 
 use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::RotMode;
-use dexcube_operator::stages::{KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached};
+use dexcube_operator::stages::{
+    KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached,
+};
 use dexcube_operator::{Failure, Operator, OperatorConfig, Outcome, move_plan, set_up_scramble};
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{Scene, SceneKind, Sim};
@@ -14,14 +16,23 @@ use rand_chacha::ChaCha8Rng;
 const RESTING: [f64; 3] = [1.0, 0.87, 0.2];
 const U_PRIME: f64 = std::f64::consts::FRAC_PI_2;
 
-fn attempt(stage1: &mut dyn Stage1, stage2: &mut dyn Stage2, rollback: bool, distance: usize, seed: u64) -> Outcome {
+fn attempt(
+    stage1: &mut dyn Stage1,
+    stage2: &mut dyn Stage2,
+    rollback: bool,
+    distance: usize,
+    seed: u64,
+) -> Outcome {
     let table = DistanceTable::build();
     let scramble = scrambles_at_distance(&table, distance, 1, seed).remove(0);
     let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
     set_up_scramble(&mut sim, &scramble.moves, RESTING);
     let accepts = pose_reached(RotMode::Axis);
     let mut operator = Operator {
-        config: OperatorConfig { rollback, ..OperatorConfig::default() },
+        config: OperatorConfig {
+            rollback,
+            ..OperatorConfig::default()
+        },
         stage1,
         stage1_accepts: &accepts,
         stage2,
@@ -37,11 +48,22 @@ fn attempt(stage1: &mut dyn Stage1, stage2: &mut dyn Stage2, rollback: bool, dis
 fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
     let table = DistanceTable::build();
     for (distance, seed) in [(1, 0), (4, 1), (9, 2), (14, 3)] {
-        let outcome = attempt(&mut KinematicStage1, &mut KinematicStage2 { angle: U_PRIME }, true, distance, seed);
+        let outcome = attempt(
+            &mut KinematicStage1,
+            &mut KinematicStage2 { angle: U_PRIME },
+            true,
+            distance,
+            seed,
+        );
         assert!(outcome.solved, "distance {distance}: {outcome:?}");
-        let plan = table.solve(&dexcube_cube::Position::of(&scrambles_at_distance(&table, distance, 1, seed)[0].facelets));
+        let plan = table.solve(&dexcube_cube::Position::of(
+            &scrambles_at_distance(&table, distance, 1, seed)[0].facelets,
+        ));
         let expected: usize = plan.iter().map(|&m| 1 + move_plan(m).1).sum();
-        assert_eq!(outcome.actions, expected, "one Stage 1 and 1 or 3 Stage 2 runs per move");
+        assert_eq!(
+            outcome.actions, expected,
+            "one Stage 1 and 1 or 3 Stage 2 runs per move"
+        );
         assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
     }
 }
@@ -63,7 +85,13 @@ impl Stage1 for MissingStage1 {
 
 #[test]
 fn an_off_pose_after_stage_1_is_randomised_and_retried() {
-    let outcome = attempt(&mut MissingStage1 { misses: 1 }, &mut KinematicStage2 { angle: U_PRIME }, true, 3, 4);
+    let outcome = attempt(
+        &mut MissingStage1 { misses: 1 },
+        &mut KinematicStage2 { angle: U_PRIME },
+        true,
+        3,
+        4,
+    );
     assert!(outcome.solved, "{outcome:?}");
     assert_eq!(outcome.randomisations, 1);
 }
@@ -75,14 +103,27 @@ struct SloppyStage2 {
 
 impl Stage2 for SloppyStage2 {
     fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let extra = if std::mem::take(&mut self.sloppy) { 25f64.to_radians() } else { 0.0 };
-        KinematicStage2 { angle: U_PRIME + extra }.run(sim, watch)
+        let extra = if std::mem::take(&mut self.sloppy) {
+            25f64.to_radians()
+        } else {
+            0.0
+        };
+        KinematicStage2 {
+            angle: U_PRIME + extra,
+        }
+        .run(sim, watch)
     }
 }
 
 #[test]
 fn a_misaligned_cube_after_stage_2_is_restored_to_a_good_state() {
-    let outcome = attempt(&mut KinematicStage1, &mut SloppyStage2 { sloppy: true }, true, 3, 5);
+    let outcome = attempt(
+        &mut KinematicStage1,
+        &mut SloppyStage2 { sloppy: true },
+        true,
+        3,
+        5,
+    );
     assert!(outcome.solved, "{outcome:?}");
     assert!(outcome.randomisations >= 1, "{outcome:?}");
 }
@@ -94,21 +135,40 @@ struct BackwardsOnce {
 
 impl Stage2 for BackwardsOnce {
     fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let sign = if std::mem::take(&mut self.backwards) { -1.0 } else { 1.0 };
-        KinematicStage2 { angle: sign * U_PRIME }.run(sim, watch)
+        let sign = if std::mem::take(&mut self.backwards) {
+            -1.0
+        } else {
+            1.0
+        };
+        KinematicStage2 {
+            angle: sign * U_PRIME,
+        }
+        .run(sim, watch)
     }
 }
 
 #[test]
 fn a_move_that_did_not_happen_is_caught_and_replanned() {
-    let outcome = attempt(&mut KinematicStage1, &mut BackwardsOnce { backwards: true }, true, 5, 6);
+    let outcome = attempt(
+        &mut KinematicStage1,
+        &mut BackwardsOnce { backwards: true },
+        true,
+        5,
+        6,
+    );
     assert!(outcome.solved, "{outcome:?}");
     assert!(outcome.replans >= 1, "{outcome:?}");
 }
 
 #[test]
 fn without_rollback_the_same_mistake_is_not_recovered() {
-    let outcome = attempt(&mut KinematicStage1, &mut BackwardsOnce { backwards: true }, false, 5, 6);
+    let outcome = attempt(
+        &mut KinematicStage1,
+        &mut BackwardsOnce { backwards: true },
+        false,
+        5,
+        6,
+    );
     assert!(!outcome.solved);
     assert_eq!(outcome.failure, Some(Failure::NotSolved));
     assert_eq!(outcome.replans, 0);
@@ -117,7 +177,13 @@ fn without_rollback_the_same_mistake_is_not_recovered() {
 #[test]
 fn a_stage_that_always_turns_backwards_runs_out_of_actions() {
     // Every requested U' becomes U: primed and plain moves swap, and re-planning chases it.
-    let outcome = attempt(&mut KinematicStage1, &mut KinematicStage2 { angle: -U_PRIME }, true, 6, 7);
+    let outcome = attempt(
+        &mut KinematicStage1,
+        &mut KinematicStage2 { angle: -U_PRIME },
+        true,
+        6,
+        7,
+    );
     if !outcome.solved {
         assert_eq!(outcome.failure, Some(Failure::OutOfActions), "{outcome:?}");
     }

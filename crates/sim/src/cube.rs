@@ -190,7 +190,9 @@ pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
 /// Sets every cubelet to its nearest quarter-turn position, as a hand working the layers
 /// until they click would; velocities of the cubelets are zeroed. False if not a cube scene.
 pub fn snap_layers(sim: &mut Sim) -> bool {
-    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else { return false };
+    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else {
+        return false;
+    };
     for ball in balls {
         let (snapped, _) = rotation::snap_to_cube(&rotation::normalise(&sim.ball(ball)), group());
         sim.set_ball(ball, &snapped);
