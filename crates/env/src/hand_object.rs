@@ -167,6 +167,21 @@ impl HandObject {
     }
 }
 
+/// Where a scene's object comes to rest on the palm: it settles from the scene's start with
+/// a neutral action (or stays at its start if it would fall). Leaves `sim` reset.
+pub fn resting_point(sim: &mut Sim) -> [f64; 3] {
+    sim.reset();
+    let start = sim.object_pose();
+    settle(sim);
+    let settled = sim.object_pose().position;
+    sim.reset();
+    if settled[2] > start.position[2] - DROP_DEPTH {
+        settled
+    } else {
+        start.position
+    }
+}
+
 /// Lets the object settle with a neutral action; false if the physics blew up.
 fn settle(sim: &mut Sim) -> bool {
     sim.set_action(&[0.0; HAND_ACTUATORS]);

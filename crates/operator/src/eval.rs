@@ -131,7 +131,7 @@ pub fn run_cube(
     hooks: Hooks,
 ) -> crate::Outcome {
     let mut sim = Sim::new(scene.clone());
-    let resting = sim.object_pose().position;
+    let resting = dexcube_env::resting_point(&mut sim);
     set_up_scramble(&mut sim, scramble, resting);
     let accepts = pose_reached(stages.rot_mode);
     let mut operator = Operator {
@@ -150,11 +150,12 @@ pub fn run_cube(
     operator.solve(&mut sim, hooks.narrate)
 }
 
-/// The cube scene's resting point: where the cube starts on the palm.
+/// The cube scene's resting point: where the cube settles on the palm, found as the
+/// environments find theirs, so Stage 1's position target means the same in both.
 pub fn resting_point() -> Result<[f64; 3], dexcube_sim::SimError> {
-    Ok(Sim::new(Scene::load(SceneKind::Cube)?)
-        .object_pose()
-        .position)
+    Ok(dexcube_env::resting_point(&mut Sim::new(Scene::load(
+        SceneKind::Cube,
+    )?)))
 }
 
 /// One row of Table I.
