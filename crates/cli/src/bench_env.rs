@@ -3,6 +3,7 @@
 //! with the same actions in the same run; their ratio is the environments' overhead.
 
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Instant;
 
 use clap::Args;
@@ -82,20 +83,20 @@ fn vec_env_rate<E: SimulatedEnv>(
 
 fn measure<E: SimulatedEnv>(
     name: &'static str,
-    kind: SceneKind,
+    scene: &Arc<Scene>,
     make: impl Fn() -> E,
     args: &EnvArgs,
-) -> anyhow::Result<EnvSpeed> {
-    let scene = Scene::load(kind)?;
+) -> EnvSpeed {
     let all = std::thread::available_parallelism().map_or(2, |n| n.get());
     let mut counts = vec![1, 2, all];
+    counts.sort();
     counts.dedup();
     let (mut sim, mut threads, mut physics, mut overhead) = (0.0f64, vec![], 1.0, f64::INFINITY);
     for &n in &counts {
         let mut best = 0.0f64;
         for _ in 0..2 {
             if n == 1 {
-                sim = sim.max(through_sim(&scene, &actions(args.steps, args.seed)).0);
+                sim = sim.max(through_sim(scene, &actions(args.steps, args.seed)).0);
             }
             let (rate, per_step, outside) = vec_env_rate(&make, n, args.steps, args.seed);
             best = best.max(rate);
@@ -106,13 +107,13 @@ fn measure<E: SimulatedEnv>(
         }
         threads.push((n, best));
     }
-    Ok(EnvSpeed {
+    EnvSpeed {
         env: name,
         sim_steps_per_s: sim,
         threads,
         physics_per_env_step: physics,
         overhead,
-    })
+    }
 }
 
 pub fn run(args: EnvArgs) -> anyhow::Result<ExitCode> {
@@ -121,16 +122,16 @@ pub fn run(args: EnvArgs) -> anyhow::Result<ExitCode> {
     let reports = [
         measure(
             "CubeRotEnv",
-            SceneKind::Rot,
+            &rot_scene,
             || CubeRotEnv::with_scene(rot_scene.clone(), RotGoal::paper(RotMode::Paper)),
             &args,
-        )?,
+        ),
         measure(
             "LayerOpEnv",
-            SceneKind::Layer,
+            &layer_scene,
             || LayerOpEnv::with_scene(layer_scene.clone(), LayerMove::UPrime, LayerGoals::Training),
             &args,
-        )?,
+        ),
     ];
     let machine = machine_scaling();
     if args.json {

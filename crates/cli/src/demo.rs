@@ -58,7 +58,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         if args.no_rollback { "off" } else { "on" }
     )?;
     let scene = Scene::load(SceneKind::Cube)?;
-    let mut stages = files.load(resting_point()?[2])?;
+    let mut stages = files.load(resting_point()?)?;
     let mut frames: Vec<Frame> = Vec::new();
     let mut renderer = match &args.video {
         Some(_) => Some(FrameRenderer::new(

@@ -167,7 +167,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let scene = Scene::load(SceneKind::Cube)?;
-    let resting_z = dexcube_operator::eval::resting_point()?[2];
+    let resting = dexcube_operator::eval::resting_point()?;
     let shared = Mutex::new(std::mem::take(&mut results));
     let next = AtomicUsize::new(0);
     let jobs = Arc::new(jobs);
@@ -189,7 +189,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     std::thread::scope(|s| {
         for _ in 0..args.threads.max(1) {
             s.spawn(|| {
-                let mut stages = match files.load(resting_z) {
+                let mut stages = match files.load(resting) {
                     Ok(stages) => stages,
                     Err(e) => {
                         failures.lock().expect("lock").replace(e.into());

@@ -86,21 +86,12 @@ impl HandObject {
     }
 
     pub fn dropped(&self) -> bool {
-        self.sim.object_pose().position[2] < self.resting[2] - DROP_DEPTH
+        is_dropped(&self.sim, self.resting[2])
     }
 
-    /// The 61 shared observations; the orientation is given with w ≥ 0.
+    /// The 61 shared observations.
     pub fn base_observation(&self) -> Vec<f64> {
-        let pose = self.sim.object_pose();
-        let (velocity, angular) = self.sim.object_velocity();
-        let mut out = Vec::with_capacity(BASE_OBSERVATION + 1);
-        out.extend(self.sim.hand_angles());
-        out.extend(self.sim.hand_velocities());
-        out.extend(pose.position);
-        out.extend(canonical(pose.orientation));
-        out.extend(velocity);
-        out.extend(angular);
-        out
+        base_observation(&self.sim)
     }
 
     /// One control step; returns a physics error if the state blew up (the simulation is then
@@ -165,6 +156,27 @@ impl HandObject {
             physics_error,
         }
     }
+}
+
+/// The 61 observations both environments share, from any scene with an object on the hand:
+/// joint angles, joint velocities, object position, orientation (w ≥ 0), velocity, angular
+/// velocity. The operator feeds the trained policies the same from the physical cube.
+pub fn base_observation(sim: &Sim) -> Vec<f64> {
+    let pose = sim.object_pose();
+    let (velocity, angular) = sim.object_velocity();
+    let mut out = Vec::with_capacity(BASE_OBSERVATION + 1);
+    out.extend(sim.hand_angles());
+    out.extend(sim.hand_velocities());
+    out.extend(pose.position);
+    out.extend(canonical(pose.orientation));
+    out.extend(velocity);
+    out.extend(angular);
+    out
+}
+
+/// True once the object has fallen `DROP_DEPTH` below the height it rests at on the palm.
+pub fn is_dropped(sim: &Sim, resting_z: f64) -> bool {
+    sim.object_pose().position[2] < resting_z - DROP_DEPTH
 }
 
 /// Where a scene's object comes to rest on the palm: it settles from the scene's start with

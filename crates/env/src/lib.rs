@@ -24,7 +24,7 @@ use std::sync::Arc;
 
 pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
-pub use hand_object::{DROP_DEPTH, resting_point};
+pub use hand_object::{DROP_DEPTH, base_observation, is_dropped, resting_point};
 pub use layer::{LayerMove, LayerOpEnv};
 pub use rot::CubeRotEnv;
 pub use vec_env::VecEnv;

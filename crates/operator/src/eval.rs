@@ -39,15 +39,18 @@ pub struct PolicyFiles {
     pub rot_mode: RotMode,
 }
 
-/// Stage 1 and Stage 2 loaded from files, ready to drive one simulation.
+/// Stage 1 and Stage 2 loaded from files, ready to drive one simulation, with the cube
+/// scene's resting point (Stage 1's target position and the drop test's reference).
 pub struct LoadedStages {
     pub stage1: PolicyStage1,
     pub stage2: PolicyStage2,
     pub rot_mode: RotMode,
+    pub resting: [f64; 3],
 }
 
 impl PolicyFiles {
-    pub fn load(&self, resting_z: f64) -> Result<LoadedStages, CheckpointError> {
+    /// Loads both policies for a cube scene whose object rests at `resting`.
+    pub fn load(&self, resting: [f64; 3]) -> Result<LoadedStages, CheckpointError> {
         let device = Device::flex();
         Ok(LoadedStages {
             stage1: PolicyStage1 {
@@ -56,9 +59,10 @@ impl PolicyFiles {
             },
             stage2: PolicyStage2 {
                 policy: Policy::load(&self.layer, &device)?,
-                resting_z,
+                resting_z: resting[2],
             },
             rot_mode: self.rot_mode,
+            resting,
         })
     }
 }
@@ -131,7 +135,7 @@ pub fn run_cube(
     hooks: Hooks,
 ) -> crate::Outcome {
     let mut sim = Sim::new(scene.clone());
-    let resting = dexcube_env::resting_point(&mut sim);
+    let resting = stages.resting;
     set_up_scramble(&mut sim, scramble, resting);
     let accepts = pose_reached(stages.rot_mode);
     let mut operator = Operator {

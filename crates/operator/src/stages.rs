@@ -7,7 +7,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
-use dexcube_env::{EPISODE_STEPS, Goal, RotGoal, RotMode};
+use dexcube_env::{EPISODE_STEPS, Goal, RotGoal, RotMode, base_observation, is_dropped};
 use dexcube_rl::Policy;
 use dexcube_sim::cube::{CubeState, face_normal, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
@@ -49,23 +49,6 @@ pub struct StageRun {
     pub diverged: bool,
 }
 
-/// The cube's observation in the environments' layout: hand angles 24, velocities 24, cube
-/// position 3, orientation 4 (w ≥ 0), velocity 3, angular velocity 3.
-fn base_observation(sim: &Sim) -> Vec<f64> {
-    let pose = sim.object_pose();
-    let (velocity, angular) = sim.object_velocity();
-    let q = pose.orientation;
-    let q = if q[0] < 0.0 { q.map(|x| -x) } else { q };
-    let mut out = Vec::with_capacity(62);
-    out.extend(sim.hand_angles());
-    out.extend(sim.hand_velocities());
-    out.extend(pose.position);
-    out.extend(q);
-    out.extend(velocity);
-    out.extend(angular);
-    out
-}
-
 /// Runs a policy for up to an episode, stopping early when `done` says so.
 fn drive(
     sim: &mut Sim,
@@ -91,7 +74,7 @@ fn drive(
             break;
         }
         watch(sim);
-        if sim.object_pose().position[2] < resting_z - dexcube_env::DROP_DEPTH {
+        if is_dropped(sim, resting_z) {
             run.dropped = true;
             break;
         }
@@ -108,20 +91,12 @@ pub struct PolicyStage1 {
 impl Stage1 for PolicyStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
         let goal: Vec<f64> = position.iter().chain(target.iter()).copied().collect();
-        let judge = RotGoal::paper(self.mode);
-        let achieved = |sim: &Sim| {
-            let p = sim.object_pose();
-            p.position
-                .iter()
-                .chain(p.orientation.iter())
-                .copied()
-                .collect::<Vec<f64>>()
-        };
+        let reached = pose_reached(self.mode);
         let policy = &self.policy;
         drive(
             sim,
             |sim| policy.act(&base_observation(sim), &goal),
-            |sim| judge.is_success(&achieved(sim), &goal),
+            |sim| reached(sim, position, target),
             position[2],
             watch,
         )

@@ -97,15 +97,14 @@ impl Agent {
 
     /// Normalised network inputs [o, g] for `n` rows.
     fn inputs(&self, observation: &[f64], goal: &[f64], n: usize, device: &Device) -> Tensor<2> {
-        let (dobs, dgoal) = (self.dims.observation, self.dims.goal);
-        let mut x = Vec::with_capacity(n * (dobs + dgoal));
-        for i in 0..n {
-            self.observation_norm
-                .normalize_into(&observation[i * dobs..(i + 1) * dobs], &mut x);
-            self.goal_norm
-                .normalize_into(&goal[i * dgoal..(i + 1) * dgoal], &mut x);
-        }
-        Tensor::from_data(TensorData::new(x, [n, dobs + dgoal]), device)
+        network_inputs(
+            &self.observation_norm,
+            &self.goal_norm,
+            observation,
+            goal,
+            n,
+            device,
+        )
     }
 
     /// Actions for `n` (observation, goal) rows. Exploring adds Gaussian noise of
@@ -196,13 +195,13 @@ impl Agent {
                 .map(|(t, o)| keep * t + (1.0 - keep) * o)
                 .collect()
         };
-        let online_actor = params::read(&self.actor.valid());
+        self.policy = self.actor.valid();
+        let online_actor = params::read(&self.policy);
         let online_critic = params::read(&self.critic.valid());
         self.target_actor =
             params::write(self.target_actor.clone(), &online_actor, blend).expect("same layout");
         self.target_critic =
             params::write(self.target_critic.clone(), &online_critic, blend).expect("same layout");
-        self.policy = self.actor.valid();
     }
 
     /// True when no target-network parameter requires a gradient (they live on the plain
@@ -220,10 +219,15 @@ impl Agent {
         !any.0
     }
 
+    /// The actor's parameters: what a shipped policy holds.
+    pub fn actor_params(&self) -> Vec<params::NamedTensor> {
+        params::read(&self.actor.valid())
+    }
+
     /// The four networks' parameters, for checkpoints: actor, critic, target actor, target critic.
     pub fn networks(&self) -> [Vec<params::NamedTensor>; 4] {
         [
-            params::read(&self.actor.valid()),
+            self.actor_params(),
             params::read(&self.critic.valid()),
             params::read(&self.target_actor),
             params::read(&self.target_critic),
@@ -252,4 +256,23 @@ fn scalar(t: &Tensor<1>) -> f64 {
         .ok()
         .and_then(|v| v.first().copied())
         .unwrap_or(f64::NAN)
+}
+
+/// Network inputs for `n` rows: each observation and goal normalised and concatenated, as
+/// `[n, observation + goal]`. The agent and a shipped policy build their inputs alike.
+pub fn network_inputs(
+    observation_norm: &Normalizer,
+    goal_norm: &Normalizer,
+    observation: &[f64],
+    goal: &[f64],
+    n: usize,
+    device: &Device,
+) -> Tensor<2> {
+    let (dobs, dgoal) = (observation_norm.size(), goal_norm.size());
+    let mut x = Vec::with_capacity(n * (dobs + dgoal));
+    for i in 0..n {
+        observation_norm.normalize_into(&observation[i * dobs..(i + 1) * dobs], &mut x);
+        goal_norm.normalize_into(&goal[i * dgoal..(i + 1) * dgoal], &mut x);
+    }
+    Tensor::from_data(TensorData::new(x, [n, dobs + dgoal]), device)
 }

@@ -5,10 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use burn::prelude::*;
-use burn::tensor::TensorData;
 use serde::{Deserialize, Serialize};
 
-use crate::agent::{Agent, Dims};
+use crate::agent::{Agent, Dims, network_inputs};
 use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
 use crate::networks::Mlp;
@@ -55,7 +54,7 @@ impl Policy {
             goal_norm: agent.goal_norm.clone(),
             metadata,
         };
-        checkpoint::save_tensors(&weights, &agent.networks()[0])?;
+        checkpoint::save_tensors(&weights, &agent.actor_params())?;
         checkpoint::save_json(&card_path, &card)
     }
 
@@ -85,17 +84,15 @@ impl Policy {
 
     /// The deterministic action for one observation and goal.
     pub fn act(&self, observation: &[f64], goal: &[f64]) -> Vec<f64> {
-        let Dims {
-            observation: dobs,
-            goal: dgoal,
-            ..
-        } = self.card.dims;
-        let mut x = Vec::with_capacity(dobs + dgoal);
-        self.card
-            .observation_norm
-            .normalize_into(observation, &mut x);
-        self.card.goal_norm.normalize_into(goal, &mut x);
-        let x: Tensor<2> = Tensor::from_data(TensorData::new(x, [1, dobs + dgoal]), &self.device);
+        let card = &self.card;
+        let x = network_inputs(
+            &card.observation_norm,
+            &card.goal_norm,
+            observation,
+            goal,
+            1,
+            &self.device,
+        );
         let out = self.actor.forward(x).tanh().into_data().convert::<f64>();
         out.try_to_vec::<f64>().unwrap_or_default()
     }

@@ -80,9 +80,23 @@ impl HerBuffer {
                 continue;
             }
             let t = rng.random_range(0..episode.len);
-            let future = (rng.random::<f64>() < self.future_probability)
-                .then(|| rng.random_range(t + 1..=episode.len));
-            return (episode, t, future);
+            return (episode, t, self.relabel(episode, t, rng));
+        }
+    }
+
+    /// HER's "future" choice for step `t`: with probability k/(k+1), a uniformly chosen later
+    /// step whose achieved goal becomes the goal; otherwise `None`, keeping the real goal.
+    fn relabel(&self, episode: &Episode, t: usize, rng: &mut ChaCha8Rng) -> Option<usize> {
+        (rng.random::<f64>() < self.future_probability)
+            .then(|| rng.random_range(t + 1..=episode.len))
+    }
+
+    /// Step `t`'s goal, or the achieved goal of step `future` when relabelled.
+    fn goal_of<'e>(&self, episode: &'e Episode, t: usize, future: Option<usize>) -> &'e [f64] {
+        let dgoal = self.dims.goal;
+        match future {
+            Some(f) => &episode.achieved_goal[f * dgoal..(f + 1) * dgoal],
+            None => &episode.desired_goal[t * dgoal..(t + 1) * dgoal],
         }
     }
 
@@ -99,10 +113,7 @@ impl HerBuffer {
         };
         for _ in 0..size {
             let (episode, t, future) = self.draw(rng);
-            let goal = match future {
-                Some(f) => &episode.achieved_goal[f * dgoal..(f + 1) * dgoal],
-                None => &episode.desired_goal[t * dgoal..(t + 1) * dgoal],
-            };
+            let goal = self.goal_of(episode, t, future);
             let achieved_next = &episode.achieved_goal[(t + 1) * dgoal..(t + 2) * dgoal];
             batch
                 .reward
@@ -123,30 +134,20 @@ impl HerBuffer {
 
     /// Observations and relabelled goals from one episode, as HER baselines feed its
     /// normalisers: `count` draws with the same relabelling as training batches.
-    pub fn normalizer_rows(
+    pub fn normalizer_rows<'e>(
         &self,
-        episode: &Episode,
+        episode: &'e Episode,
         count: usize,
         rng: &mut ChaCha8Rng,
-    ) -> Vec<(Vec<f64>, Vec<f64>)> {
-        let Dims {
-            observation: dobs,
-            goal: dgoal,
-            ..
-        } = self.dims;
+    ) -> Vec<(&'e [f64], &'e [f64])> {
+        let dobs = self.dims.observation;
         (0..count)
             .map(|_| {
                 let t = rng.random_range(0..episode.len);
-                let use_future = rng.random::<f64>() < self.future_probability;
-                let g = if use_future {
-                    let f = rng.random_range(t + 1..=episode.len);
-                    &episode.achieved_goal[f * dgoal..(f + 1) * dgoal]
-                } else {
-                    &episode.desired_goal[t * dgoal..(t + 1) * dgoal]
-                };
+                let future = self.relabel(episode, t, rng);
                 (
-                    episode.observation[t * dobs..(t + 1) * dobs].to_vec(),
-                    g.to_vec(),
+                    &episode.observation[t * dobs..(t + 1) * dobs],
+                    self.goal_of(episode, t, future),
                 )
             })
             .collect()

@@ -172,6 +172,7 @@ pub fn train<E: GoalEnv>(
         metrics = resume(&mut agent, dir, options)?;
     }
     let cycles = config.cycles_per_epoch as u64;
+    let updates_per_epoch = (config.cycles_per_epoch * config.batches_per_cycle) as f64;
     let bar = progress_bar(options, config.cycles_per_epoch, metrics.len());
     let wall_before = metrics.last().map_or(0.0, |m| m.wall_s);
     let started = Instant::now();
@@ -203,19 +204,17 @@ pub fn train<E: GoalEnv>(
             );
             for episode in episodes {
                 for (o, g) in buffer.normalizer_rows(&episode, episode.len, &mut rng) {
-                    agent.observation_norm.update(&o);
-                    agent.goal_norm.update(&g);
+                    agent.observation_norm.update(o);
+                    agent.goal_norm.update(g);
                 }
                 buffer.store(episode);
             }
             for _ in 0..config.batches_per_cycle {
                 let batch = buffer.sample(config.batch_size, &mut rng);
                 let s = agent.train(&batch);
-                stats.critic_loss +=
-                    s.critic_loss / (cycles as usize * config.batches_per_cycle) as f64;
-                stats.actor_loss +=
-                    s.actor_loss / (cycles as usize * config.batches_per_cycle) as f64;
-                stats.mean_q += s.mean_q / (cycles as usize * config.batches_per_cycle) as f64;
+                stats.critic_loss += s.critic_loss / updates_per_epoch;
+                stats.actor_loss += s.actor_loss / updates_per_epoch;
+                stats.mean_q += s.mean_q / updates_per_epoch;
             }
             agent.end_cycle();
             learning_s += t.elapsed().as_secs_f64();

@@ -13,7 +13,7 @@ use dexcube_cube::facelet::{CORNER_COLOURS, CORNER_FACELETS, CORNER_NAMES, DBL};
 use dexcube_cube::{Face, FaceletError, Facelets, Move};
 
 use crate::rotation::{self, IDENTITY, Quat};
-use crate::scene::ObjectJoints;
+use crate::scene::JointAddress;
 use crate::sim::{Pose, Sim};
 
 /// The detent that pulls each cubelet towards the nearest quarter-turn position, as the
@@ -42,12 +42,10 @@ pub struct CubeState {
 impl CubeState {
     /// Reads the cube; `None` if the simulation is not of the `cube` scene.
     pub fn read(sim: &Sim) -> Option<CubeState> {
-        let ObjectJoints::Cube { balls, .. } = sim.scene().object() else {
-            return None;
-        };
+        let balls = sim.scene().object().cube_balls()?;
         let mut rotations = [IDENTITY; 8];
-        for (slot, ball) in balls.iter().enumerate() {
-            rotations[slot] = rotation::normalise(&sim.ball(*ball));
+        for (slot, ball) in balls.into_iter().enumerate() {
+            rotations[slot] = rotation::normalise(&sim.ball(ball));
         }
         Some(CubeState {
             pose: sim.object_pose(),
@@ -142,7 +140,7 @@ pub fn turn_face(sim: &mut Sim, m: Move) -> bool {
 /// Turns the layer facing `face` in the world by `angle` radians about its outward normal
 /// (counter-clockwise seen from outside is positive), kinematically.
 pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
-    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else {
+    let Some(balls) = sim.scene().object().cube_balls() else {
         return false;
     };
     let Some(state) = CubeState::read(sim) else {
@@ -190,7 +188,7 @@ pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
 /// Sets every cubelet to its nearest quarter-turn position, as a hand working the layers
 /// until they click would; velocities of the cubelets are zeroed. False if not a cube scene.
 pub fn snap_layers(sim: &mut Sim) -> bool {
-    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else {
+    let Some(balls) = sim.scene().object().cube_balls() else {
         return false;
     };
     for ball in balls {
@@ -202,11 +200,8 @@ pub fn snap_layers(sim: &mut Sim) -> bool {
 }
 
 /// Sets each cubelet's detent torque as an applied joint force, for the next physics step.
-pub(crate) fn apply_detent(sim: &mut Sim) {
-    let ObjectJoints::Cube { balls, .. } = sim.scene().object().clone() else {
-        return;
-    };
-    for ball in balls {
+pub(crate) fn apply_detent(sim: &mut Sim, balls: &[JointAddress; 7]) {
+    for &ball in balls {
         let q = rotation::normalise(&sim.ball(ball));
         let (snapped, angle) = rotation::snap_to_cube(&q, group());
         let torque = if !(1e-9..DETENT_CAPTURE).contains(&angle) {

@@ -80,6 +80,14 @@ pub enum ObjectJoints {
 }
 
 impl ObjectJoints {
+    /// The ball joints of the physical cube's seven moving cubelets; `None` in other scenes.
+    pub fn cube_balls(&self) -> Option<[JointAddress; 7]> {
+        match self {
+            ObjectJoints::Cube { balls, .. } => Some(*balls),
+            _ => None,
+        }
+    }
+
     /// The free joint that places the object in the world.
     pub fn free(&self) -> JointAddress {
         match self {

@@ -9,7 +9,7 @@ use mujoco_rs::prelude::*;
 
 use crate::error::SimError;
 use crate::rotation::Quat;
-use crate::scene::{HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene, SceneKind};
+use crate::scene::{HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene};
 
 /// Physics substeps of 0.002 s per control step, as in Gymnasium-Robotics' hand envs.
 pub const SUBSTEPS: usize = 20;
@@ -94,8 +94,8 @@ impl Sim {
 
     /// Sets the hand's actuator targets from an action in [-1, 1]^20.
     pub fn set_action(&mut self, action: &[f64; HAND_ACTUATORS]) {
-        let scene = self.scene.clone();
-        scene.action_to_ctrl(action, &mut self.data.ctrl_mut()[..HAND_ACTUATORS]);
+        self.scene
+            .action_to_ctrl(action, &mut self.data.ctrl_mut()[..HAND_ACTUATORS]);
     }
 
     /// One control step: `SUBSTEPS` physics steps. Fails if the state blew up, in which case
@@ -104,10 +104,11 @@ impl Sim {
         let start = std::time::Instant::now();
         let before = self.bad_state_warnings();
         self.control_steps += 1;
-        let detent = matches!(self.scene.kind(), SceneKind::Cube);
+        // Only the physical cube has cubelets to hold in line.
+        let cubelets = self.scene.object().cube_balls();
         for _ in 0..SUBSTEPS {
-            if detent {
-                crate::cube::apply_detent(self);
+            if let Some(balls) = &cubelets {
+                crate::cube::apply_detent(self, balls);
             }
             self.data.step();
         }
