@@ -113,6 +113,7 @@ pub fn run(args: RlArgs) -> anyhow::Result<ExitCode> {
         seed,
         out_dir: None,
         resume: false,
+        init_from: None,
         progress: false,
         label: "bench".into(),
         metadata: serde_json::json!({}),

@@ -29,7 +29,8 @@ pub enum EnvKind {
 pub struct EnvChoice {
     #[arg(value_enum)]
     pub env: EnvKind,
-    /// CubeRotEnv's success test: paper (whole orientation) or axis (the up axis only).
+    /// CubeRotEnv's success test: paper (whole orientation), axis (the target face up, any
+    /// yaw) or pair (the target face or its opposite up, any yaw).
     #[arg(long, default_value = "paper")]
     pub mode: RotMode,
     /// LayerOpEnv's move: U U' R R' F F'.

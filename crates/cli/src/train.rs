@@ -44,6 +44,14 @@ pub struct TrainArgs {
     /// Continue the run in this folder from its last checkpoint.
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
+    /// Warm start from the networks and normalisers of the run in this folder (for example
+    /// to fine-tune on another success test or goal range); a new run in --out.
+    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
+    init: Option<PathBuf>,
+    /// LayerOpEnv only: train on the evaluation goal, exactly a quarter turn, rather than
+    /// goals uniform over it (HER still relabels with the angles reached on the way).
+    #[arg(long)]
+    quarter_goals: bool,
     /// Optimisation batches per cycle (HER baselines: 40).
     #[arg(long, default_value_t = 40)]
     batches: usize,
@@ -63,8 +71,15 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     }
     let (name, variant) = match args.choice.env {
         EnvKind::Rot => ("rot", args.choice.mode.name().to_string()),
-        EnvKind::Layer => ("layer", args.choice.layer_move.name().replace('\'', "p")),
+        EnvKind::Layer => (
+            "layer",
+            args.choice.layer_move.name().replace('\'', "p")
+                + if args.quarter_goals { "-quarter" } else { "" },
+        ),
     };
+    if args.quarter_goals && matches!(args.choice.env, EnvKind::Rot) {
+        bail!("--quarter-goals is for LayerOpEnv (train layer)");
+    }
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
         (Some(dir), None) => (dir.clone(), false),
@@ -85,9 +100,14 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         seed,
         out_dir: Some(out.clone()),
         resume,
+        init_from: args.init.clone(),
         progress: true,
         label: args.choice.name(),
-        metadata: serde_json::json!({ "env": name, "variant": variant }),
+        metadata: serde_json::json!({
+            "env": name,
+            "variant": variant,
+            "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
+        }),
     };
     eprintln!(
         "training {} into {} (seed {})",
@@ -108,8 +128,13 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         EnvKind::Layer => {
             let scene = Scene::load(SceneKind::Layer)?;
             let layer_move = args.choice.layer_move;
+            let goals = if args.quarter_goals {
+                LayerGoals::Evaluation
+            } else {
+                LayerGoals::Training
+            };
             train(
-                || LayerOpEnv::with_scene(scene.clone(), layer_move, LayerGoals::Training),
+                || LayerOpEnv::with_scene(scene.clone(), layer_move, goals),
                 config,
                 &options,
             )?

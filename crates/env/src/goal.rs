@@ -34,6 +34,12 @@ pub enum RotMode {
     /// Only the axis that should point up: the rotation about the vertical is free. This is
     /// all a following layer turn needs.
     Axis,
+    /// The target face or the opposite face up, rotation about the vertical free: either way
+    /// the move's layer pair lies top and bottom, and a U' of the top layer then makes the
+    /// same move (X' and its opposite face's turn, each seen from its own side, are one move
+    /// up to a whole-cube turn). The paper's own reason for three poses, not six, taken one
+    /// step on: no pose is more than 90° from an accepted one.
+    Pair,
 }
 
 /// CubeRotEnv's goal: position (3) and orientation quaternion (4, w first).
@@ -76,10 +82,15 @@ impl Goal for RotGoal {
             // 2·arccos(|Re(q'·conj(q))|): the angle of the rotation between the two.
             RotMode::Paper => rotation::angle_between(&a, &d),
             // The cube axis the target holds up, and where the achieved pose points it.
-            RotMode::Axis => {
+            RotMode::Axis | RotMode::Pair => {
                 let up = rotation::rotate(&rotation::conj(&d), [0.0, 0.0, 1.0]);
-                let now = rotation::rotate(&a, up);
-                now[2].clamp(-1.0, 1.0).acos()
+                let now = rotation::rotate(&a, up)[2];
+                let cos = if self.mode == RotMode::Pair {
+                    now.abs()
+                } else {
+                    now
+                };
+                cos.clamp(-1.0, 1.0).acos()
             }
         };
         (position, angle)

@@ -165,6 +165,7 @@ impl RotMode {
         match self {
             RotMode::Paper => "paper",
             RotMode::Axis => "axis",
+            RotMode::Pair => "pair",
         }
     }
 }
@@ -175,8 +176,9 @@ impl std::str::FromStr for RotMode {
         match s {
             "paper" => Ok(RotMode::Paper),
             "axis" => Ok(RotMode::Axis),
+            "pair" => Ok(RotMode::Pair),
             other => Err(format!(
-                "unknown CubeRotEnv mode '{other}': use paper or axis"
+                "unknown CubeRotEnv mode '{other}': use paper, axis or pair"
             )),
         }
     }

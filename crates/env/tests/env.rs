@@ -78,7 +78,7 @@ fn compute_reward_agrees_with_step_on_thousands_of_transitions() {
 
 #[test]
 fn rot_success_is_detected_just_inside_and_not_just_outside_the_thresholds() {
-    for mode in [RotMode::Paper, RotMode::Axis] {
+    for mode in [RotMode::Paper, RotMode::Axis, RotMode::Pair] {
         let mut env = CubeRotEnv::new(mode).unwrap();
         env.reset(Some(3));
         let target_q = rotation::about([0.0, 1.0, 0.0], -std::f64::consts::FRAC_PI_2);
@@ -122,9 +122,17 @@ fn rot_success_is_detected_just_inside_and_not_just_outside_the_thresholds() {
         let yawed = rotation::mul(&about([0.0, 0.0, 1.0], 1.0), &target_q);
         assert_eq!(
             judge(rest, yawed, &mut env),
-            mode == RotMode::Axis,
+            mode != RotMode::Paper,
             "{mode:?}: turned about the vertical"
         );
+        let flipped = rotation::mul(&about([1.0, 0.0, 0.0], std::f64::consts::PI), &target_q);
+        assert_eq!(
+            judge(rest, flipped, &mut env),
+            mode == RotMode::Pair,
+            "{mode:?}: the opposite face up"
+        );
+        let sideways = rotation::mul(&about([1.0, 0.0, 0.0], 1.5), &target_q);
+        assert!(!judge(rest, sideways, &mut env), "{mode:?}: on its side");
     }
 }
 

@@ -23,11 +23,23 @@ fn attempt(
     distance: usize,
     seed: u64,
 ) -> Outcome {
+    attempt_judged(RotMode::Axis, stage1, stage2, rollback, distance, seed)
+}
+
+/// `attempt`, with Stage 1's pose judged in `mode`.
+fn attempt_judged(
+    mode: RotMode,
+    stage1: &mut dyn Stage1,
+    stage2: &mut dyn Stage2,
+    rollback: bool,
+    distance: usize,
+    seed: u64,
+) -> Outcome {
     let table = DistanceTable::build();
     let scramble = scrambles_at_distance(&table, distance, 1, seed).remove(0);
     let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
     set_up_scramble(&mut sim, &scramble.moves, RESTING);
-    let accepts = pose_reached(RotMode::Axis);
+    let accepts = pose_reached(mode);
     let mut operator = Operator {
         config: OperatorConfig {
             rollback,
@@ -188,4 +200,54 @@ fn a_stage_that_always_turns_backwards_runs_out_of_actions() {
         assert_eq!(outcome.failure, Some(Failure::OutOfActions), "{outcome:?}");
     }
     assert!(outcome.actions <= OperatorConfig::default().max_actions + 4);
+}
+
+/// A Stage 1 that always lands with the opposite face up (turned half over about world x).
+struct UpsideDownStage1;
+
+impl Stage1 for UpsideDownStage1 {
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
+        let flipped = dexcube_sim::rotation::mul(
+            &dexcube_sim::rotation::about([1.0, 0.0, 0.0], std::f64::consts::PI),
+            &target,
+        );
+        KinematicStage1.run(sim, position, flipped, watch)
+    }
+}
+
+#[test]
+fn the_opposite_face_up_makes_the_same_move_so_pair_mode_accepts_it() {
+    for (distance, seed) in [(3, 4), (8, 5)] {
+        let perfect = attempt(
+            &mut KinematicStage1,
+            &mut KinematicStage2 { angle: U_PRIME },
+            true,
+            distance,
+            seed,
+        );
+        let flipped = attempt_judged(
+            RotMode::Pair,
+            &mut UpsideDownStage1,
+            &mut KinematicStage2 { angle: U_PRIME },
+            true,
+            distance,
+            seed,
+        );
+        assert!(flipped.solved, "distance {distance}: {flipped:?}");
+        assert_eq!(flipped.actions, perfect.actions, "distance {distance}");
+        assert_eq!(flipped.randomisations, 0, "distance {distance}");
+        let strict = attempt(
+            &mut UpsideDownStage1,
+            &mut KinematicStage2 { angle: U_PRIME },
+            true,
+            distance,
+            seed,
+        );
+        // Axis mode calls the same landing a miss: it randomises and retries every Stage 1
+        // (the U' made then is still right, so the cube gets solved, with more actions).
+        assert!(
+            strict.randomisations > 0 && strict.actions > perfect.actions,
+            "axis mode rejects the flipped pose: {strict:?}"
+        );
+    }
 }

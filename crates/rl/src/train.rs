@@ -5,7 +5,9 @@
 //!
 //! - `checkpoint/`: all four networks and `state.json` (config, normalisers, progress),
 //!   from which `resume` continues. Adam's moments and the replay buffer start empty on
-//!   resume; the networks, normalisers, metrics and episode count carry over.
+//!   resume; the networks, normalisers, metrics and episode count carry over. The same
+//!   checkpoint can also warm-start a new run (`init_from`) on a changed goal or success
+//!   test: networks and normalisers carry over, everything else starts afresh.
 //! - `best.safetensors` + `best.json`: the policy with the highest test success so far.
 //! - `policy.safetensors` + `policy.json`: the latest policy.
 //! - `metrics.csv` and `success.png`: the learning curve.
@@ -43,6 +45,9 @@ pub struct TrainOptions {
     pub out_dir: Option<PathBuf>,
     /// Continue from `out_dir/checkpoint` if it exists.
     pub resume: bool,
+    /// Warm start: take the networks and normalisers of the run in this folder (its
+    /// `checkpoint/`), then train as a new run. Only the sizes must match.
+    pub init_from: Option<PathBuf>,
     /// Show a progress bar with ETA on stderr.
     pub progress: bool,
     /// What is being trained, for plots and policy cards.
@@ -114,6 +119,7 @@ struct TrainState {
 pub enum TrainError {
     Checkpoint(CheckpointError),
     Resume(String),
+    WarmStart(String),
 }
 
 impl std::fmt::Display for TrainError {
@@ -121,6 +127,7 @@ impl std::fmt::Display for TrainError {
         match self {
             TrainError::Checkpoint(e) => e.fmt(f),
             TrainError::Resume(message) => write!(f, "cannot resume: {message}"),
+            TrainError::WarmStart(message) => write!(f, "cannot warm-start: {message}"),
         }
     }
 }
@@ -170,6 +177,9 @@ pub fn train<E: GoalEnv>(
     let mut metrics: Vec<EpochMetrics> = Vec::new();
     if let (true, Some(dir)) = (options.resume, &options.out_dir) {
         metrics = resume(&mut agent, dir, options)?;
+    }
+    if let (true, Some(dir)) = (metrics.is_empty(), &options.init_from) {
+        warm_start(&mut agent, dir)?;
     }
     let cycles = config.cycles_per_epoch as u64;
     let updates_per_epoch = (config.cycles_per_epoch * config.batches_per_cycle) as f64;
@@ -306,6 +316,7 @@ fn card_metadata(options: &TrainOptions, metrics: &[EpochMetrics]) -> serde_json
         "updates": last.map_or(0, |m| m.updates),
         "wall_s": last.map_or(0.0, |m| m.wall_s),
         "test_success": last.map_or(0.0, |m| m.test_success),
+        "init_from": options.init_from.as_ref().map(|d| d.display().to_string()),
     })
 }
 
@@ -370,37 +381,82 @@ fn resume(
     options: &TrainOptions,
 ) -> Result<Vec<EpochMetrics>, TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
-    let state_path = checkpoint_dir.join("state.json");
-    if !state_path.exists() {
+    if !checkpoint_dir.join("state.json").exists() {
         return Ok(Vec::new());
     }
-    let state: TrainState = checkpoint::load_json(&state_path)?;
-    if state.dims != agent.dims || state.config != agent.config {
-        return Err(TrainError::Resume(format!(
-            "{} was trained with other sizes or hyperparameters ({:?}); use a new --out folder",
-            checkpoint_dir.display(),
-            state.dims
+    let state = load_checkpoint(agent, &checkpoint_dir, |state, agent| {
+        if state.dims != agent.dims || state.config != agent.config {
+            return Err(TrainError::Resume(format!(
+                "{} was trained with other sizes or hyperparameters ({:?}); use a new --out folder",
+                checkpoint_dir.display(),
+                state.dims
+            )));
+        }
+        if state.label != options.label {
+            return Err(TrainError::Resume(format!(
+                "{} is a run of {}, not {}; pass the same environment and mode",
+                checkpoint_dir.display(),
+                state.label,
+                options.label
+            )));
+        }
+        if state.seed != options.seed {
+            return Err(TrainError::Resume(format!(
+                "{} was trained with seed {}, not {}",
+                checkpoint_dir.display(),
+                state.seed,
+                options.seed
+            )));
+        }
+        Ok(())
+    })?;
+    Ok(state.metrics)
+}
+
+/// Takes the networks and normalisers of the run in `dir`, for a new run.
+fn warm_start(agent: &mut Agent, dir: &Path) -> Result<(), TrainError> {
+    let checkpoint_dir = dir.join("checkpoint");
+    if !checkpoint_dir.join("state.json").exists() {
+        return Err(TrainError::WarmStart(format!(
+            "{} holds no checkpoint (a training run's folder has checkpoint/state.json)",
+            dir.display()
         )));
     }
-    if state.seed != options.seed {
-        return Err(TrainError::Resume(format!(
-            "{} was trained with seed {}, not {}",
-            checkpoint_dir.display(),
-            state.seed,
-            options.seed
-        )));
-    }
+    load_checkpoint(agent, &checkpoint_dir, |state, agent| {
+        if state.dims == agent.dims {
+            Ok(())
+        } else {
+            Err(TrainError::WarmStart(format!(
+                "{} has networks for {:?}, this environment needs {:?}",
+                checkpoint_dir.display(),
+                state.dims,
+                agent.dims
+            )))
+        }
+    })
+    .map(|_| ())
+}
+
+/// Loads a checkpoint's networks and normalisers into `agent`;
+/// `check` vets the saved state first.
+fn load_checkpoint(
+    agent: &mut Agent,
+    checkpoint_dir: &Path,
+    check: impl Fn(&TrainState, &Agent) -> Result<(), TrainError>,
+) -> Result<TrainState, TrainError> {
+    let state: TrainState = checkpoint::load_json(&checkpoint_dir.join("state.json"))?;
+    check(&state, agent)?;
     let mut networks: [Vec<crate::params::NamedTensor>; 4] = Default::default();
     for (slot, name) in networks.iter_mut().zip(NETWORK_FILES) {
         *slot = checkpoint::load_tensors(&checkpoint_dir.join(format!("{name}.safetensors")))?;
     }
     agent.load_networks(&networks).map_err(|e| {
         TrainError::Checkpoint(CheckpointError::Mismatch {
-            path: checkpoint_dir.clone(),
+            path: checkpoint_dir.to_path_buf(),
             message: e.to_string(),
         })
     })?;
-    agent.observation_norm = state.observation_norm;
-    agent.goal_norm = state.goal_norm;
-    Ok(state.metrics)
+    agent.observation_norm = state.observation_norm.clone();
+    agent.goal_norm = state.goal_norm.clone();
+    Ok(state)
 }

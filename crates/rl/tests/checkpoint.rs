@@ -23,6 +23,7 @@ fn options(dir: &std::path::Path, epochs: usize, resume: bool) -> TrainOptions {
         seed: 3,
         out_dir: Some(dir.to_path_buf()),
         resume,
+        init_from: None,
         progress: false,
         label: "point mass".into(),
         metadata: serde_json::json!({"env": "point mass"}),
@@ -83,6 +84,66 @@ fn a_run_writes_its_files_and_resumes_where_it_stopped() {
         .err()
         .unwrap();
     assert!(err.to_string().contains("cannot resume"), "{err}");
+    // So is resuming another environment or mode's run (a changed success test).
+    let relabelled = TrainOptions {
+        label: "point mass, another goal".into(),
+        ..options(&dir, 5, true)
+    };
+    let err = train(PointMassEnv::default, config(), &relabelled)
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("is a run of point mass"), "{err}");
+}
+
+#[test]
+fn a_warm_start_carries_the_networks_into_a_new_run() {
+    let source = fresh_dir("dexcube-rl-warm-source");
+    train(PointMassEnv::default, config(), &options(&source, 1, false)).unwrap();
+    let saved =
+        dexcube_rl::checkpoint::load_tensors(&source.join("checkpoint/actor.safetensors")).unwrap();
+    let dir = fresh_dir("dexcube-rl-warm");
+    let warm = TrainOptions {
+        init_from: Some(source.clone()),
+        ..options(&dir, 1, false)
+    };
+    // Another configuration is fine for a new run. With no batches, learning cannot move
+    // the actor, so what it holds at the end is what it started from.
+    let frozen = DdpgHerConfig {
+        batches_per_cycle: 0,
+        ..config()
+    };
+    let run = train(PointMassEnv::default, frozen, &warm).unwrap();
+    assert_eq!(run.metrics.len(), 1, "a new run counts its own epochs");
+    let by_name = |mut tensors: Vec<dexcube_rl::params::NamedTensor>| {
+        tensors.sort_by(|a, b| a.name.cmp(&b.name));
+        tensors
+    };
+    assert_eq!(
+        by_name(run.agent.networks()[0].clone()),
+        by_name(saved),
+        "the actor came from the source run"
+    );
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap()).unwrap();
+    assert_eq!(
+        card["metadata"]["init_from"],
+        source.display().to_string(),
+        "the card names where it started"
+    );
+    let other = DdpgHerConfig {
+        hidden: vec![16],
+        ..config()
+    };
+    let err = train(PointMassEnv::default, other, &warm).err().unwrap();
+    assert!(err.to_string().contains("does not fit"), "{err}");
+    let nowhere = TrainOptions {
+        init_from: Some(fresh_dir("dexcube-rl-warm-nowhere")),
+        ..options(&fresh_dir("dexcube-rl-warm-2"), 1, false)
+    };
+    let err = train(PointMassEnv::default, config(), &nowhere)
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("holds no checkpoint"), "{err}");
 }
 
 #[test]

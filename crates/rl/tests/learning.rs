@@ -25,6 +25,7 @@ fn options(epochs: usize) -> TrainOptions {
         seed: 1,
         out_dir: None,
         resume: false,
+        init_from: None,
         progress: false,
         label: "point mass".into(),
         metadata: serde_json::json!({}),
