@@ -60,6 +60,7 @@ pub fn run(args: RlArgs) -> anyhow::Result<ExitCode> {
             .map(|x| if x > 0.0 { -1.0 } else { 0.0 })
             .collect(),
         next_observation: random(b * dims.observation),
+        terminal: vec![0.0; b],
     };
     let mut times = Vec::with_capacity(args.updates);
     for i in 0..args.updates {

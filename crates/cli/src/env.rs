@@ -103,10 +103,10 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
     match choice.env {
         EnvKind::Rot => println!(
             "  success:     position within 0.01 m and {} within 0.1 rad; reward 0, else -1",
-            if choice.mode == RotMode::Paper {
-                "orientation"
-            } else {
-                "the up axis"
+            match choice.mode {
+                RotMode::Paper => "orientation",
+                RotMode::Axis => "the target's up axis",
+                RotMode::Pair => "the target's up axis, either way up,",
             }
         ),
         EnvKind::Layer => {

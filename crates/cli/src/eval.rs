@@ -11,7 +11,7 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotGoal, RotMode};
+use dexcube_env::{CubeRotEnv, GoalEnv, Info, LayerGoal, LayerMove, LayerOpEnv, RotGoal, RotMode};
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
@@ -280,13 +280,61 @@ pub struct EvalStageArgs {
     record: bool,
 }
 
-/// Runs a deterministic episode; true if it ends in success.
-fn episode(env: &mut dyn GoalEnv, policy: &Policy, seed: u64) -> bool {
+/// How an episode of one atomic action ended: success, or the reason it missed.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Ending {
+    Success,
+    Dropped,
+    /// Orientation (or layer angle) reached, position not.
+    PositionOff,
+    /// Position reached, orientation (or layer angle) not.
+    AngleOff,
+    BothOff,
+}
+
+impl Ending {
+    const ALL: [Ending; 5] = [
+        Ending::Success,
+        Ending::Dropped,
+        Ending::PositionOff,
+        Ending::AngleOff,
+        Ending::BothOff,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Ending::Success => "success",
+            Ending::Dropped => "dropped or blew up",
+            Ending::PositionOff => "missed on position only",
+            Ending::AngleOff => "missed on angle only",
+            Ending::BothOff => "missed on both",
+        }
+    }
+
+    fn of(info: &Info, (position, angle): (f64, f64)) -> Ending {
+        let (p, a) = (info.position_error >= position, info.angle_error >= angle);
+        match (
+            info.is_success,
+            info.dropped || info.physics_error.is_some(),
+            p,
+            a,
+        ) {
+            (true, ..) => Ending::Success,
+            (_, true, ..) => Ending::Dropped,
+            (_, _, true, false) => Ending::PositionOff,
+            (_, _, false, true) => Ending::AngleOff,
+            _ => Ending::BothOff,
+        }
+    }
+}
+
+/// Runs a deterministic episode and returns its last step's info.
+fn episode(env: &mut dyn GoalEnv, policy: &Policy, seed: u64) -> Info {
     let (mut obs, _) = env.reset(Some(seed));
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
         if t.terminated || t.truncated {
-            return t.info.is_success;
+            return t.info;
         }
         obs = t.observation;
     }
@@ -299,7 +347,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         StageKind::Layer => files.layer.clone(),
     };
     let next = AtomicUsize::new(0);
-    let successes = AtomicUsize::new(0);
+    let endings: [AtomicUsize; 5] = Default::default();
+    let rot_goal = RotGoal::paper(files.rot_mode);
+    let thresholds = match args.stage {
+        StageKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
+        StageKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
+    };
     let bar = ProgressBar::new(args.episodes as u64);
     let scene = Scene::load(match args.stage {
         StageKind::Rot => SceneKind::Rot,
@@ -311,10 +364,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             handles.push(s.spawn(|| -> anyhow::Result<()> {
                 let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
                 let mut env: Box<dyn GoalEnv> = match args.stage {
-                    StageKind::Rot => Box::new(CubeRotEnv::with_scene(
-                        scene.clone(),
-                        RotGoal::paper(files.rot_mode),
-                    )),
+                    StageKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
                     StageKind::Layer => Box::new(LayerOpEnv::with_scene(
                         scene.clone(),
                         LayerMove::UPrime,
@@ -326,9 +376,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     if k >= args.episodes {
                         return Ok(());
                     }
-                    if episode(env.as_mut(), &policy, args.seed + k as u64) {
-                        successes.fetch_add(1, Ordering::Relaxed);
-                    }
+                    let info = episode(env.as_mut(), &policy, args.seed + k as u64);
+                    endings[Ending::of(&info, thresholds) as usize].fetch_add(1, Ordering::Relaxed);
                     bar.inc(1);
                 }
             }));
@@ -340,7 +389,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         Ok(())
     })?;
     bar.finish_and_clear();
-    let wins = successes.into_inner();
+    let counts = endings.map(AtomicUsize::into_inner);
+    let wins = counts[Ending::Success as usize];
     let (lo, hi) = wilson_interval(wins, args.episodes);
     let rate = wins as f64 / args.episodes as f64;
     let what = match args.stage {
@@ -353,6 +403,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         args.seed,
         prefix.display()
     );
+    for ending in Ending::ALL.into_iter().skip(1) {
+        let n = counts[ending as usize];
+        if n > 0 {
+            println!("  {}: {n}", ending.name());
+        }
+    }
     if args.record {
         record(&prefix, &args, wins, (lo, hi))?;
     }

@@ -148,11 +148,14 @@ impl HandObject {
     ) -> Info {
         let (achieved, desired) = (&observation.achieved_goal, &observation.desired_goal);
         let (position_error, angle_error) = goal.errors(achieved, desired);
+        let dropped = self.dropped();
         Info {
-            is_success: goal.is_success(achieved, desired),
+            // A fallen object never counts, whatever its angle (LayerOpEnv's goal has no
+            // position): the episode has failed.
+            is_success: goal.is_success(achieved, desired) && !dropped && physics_error.is_none(),
             position_error,
             angle_error,
-            dropped: self.dropped(),
+            dropped,
             physics_error,
         }
     }

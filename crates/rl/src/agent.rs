@@ -3,7 +3,10 @@
 //! averaging once per cycle, and inputs normalised by running statistics.
 //!
 //! One optimisation step on a batch (o, g, u, r, o'):
-//! - target   y = clip(r + γ·Q'(o', g, π'(o', g)), -1/(1-γ), 0), no gradient;
+//! - target   y = clip(r + γ·Q'(o', g, π'(o', g)), -1/(1-γ), 0), no gradient; where o' ended
+//!   its episode in an absorbing failure (the object dropped), it fails forever after and
+//!   y = -1/(1-γ), whatever the goal. Bootstrapping from a state that no stored transition
+//!   starts from would make a drop look as good as the critic's guess about it;
 //! - critic   minimise mean (Q(o, g, u) - y)²;
 //! - actor    minimise -mean Q(o, g, π(o, g)) + action_l2 · mean π(o, g)²;
 //!
@@ -39,6 +42,8 @@ pub struct Batch {
     pub action: Vec<f32>,
     pub reward: Vec<f32>,
     pub next_observation: Vec<f64>,
+    /// 1 where `next_observation` ended its episode in an absorbing failure, else 0.
+    pub terminal: Vec<f32>,
 }
 
 /// What one optimisation step measured.
@@ -145,20 +150,39 @@ impl Agent {
         actions
     }
 
-    /// One optimisation step of actor and critic on `batch`.
-    pub fn train(&mut self, batch: &Batch) -> StepStats {
-        let (n, da) = (batch.len, self.dims.action);
-        let x = self.inputs(&batch.observation, &batch.goal, n, &self.plain);
+    /// The critic's regression targets y for `batch`, `[n, 1]` on the plain device, where no
+    /// gradient can reach them.
+    fn targets(&self, batch: &Batch) -> Tensor<2> {
+        let n = batch.len;
         let x_next = self.inputs(&batch.next_observation, &batch.goal, n, &self.plain);
-        // The target, on the plain device: no gradient can reach it.
         let next_action = self.target_actor.forward(x_next.clone()).tanh();
         let next_q = self
             .target_critic
             .forward(Tensor::cat(vec![x_next, next_action], 1));
-        let reward: Tensor<2> =
-            Tensor::from_data(TensorData::new(batch.reward.clone(), [n, 1]), &self.plain);
-        let target = (reward + next_q * self.config.gamma).clamp(-self.config.clip_return(), 0.0);
-        let target: Tensor<2> = Tensor::from_data(target.into_data(), &self.device);
+        let column = |values: &[f32]| -> Tensor<2> {
+            Tensor::from_data(TensorData::new(values.to_vec(), [n, 1]), &self.plain)
+        };
+        let (reward, terminal) = (column(&batch.reward), column(&batch.terminal));
+        let floor = self.config.clip_return();
+        let bootstrapped = reward + next_q * self.config.gamma;
+        let failed = terminal.clone() * -floor;
+        (bootstrapped * (terminal.neg() + 1.0) + failed).clamp(-floor, 0.0)
+    }
+
+    /// The critic's targets for `batch` as numbers, for tests and diagnostics.
+    pub fn td_targets(&self, batch: &Batch) -> Vec<f32> {
+        self.targets(batch)
+            .into_data()
+            .convert::<f32>()
+            .try_to_vec::<f32>()
+            .unwrap_or_default()
+    }
+
+    /// One optimisation step of actor and critic on `batch`.
+    pub fn train(&mut self, batch: &Batch) -> StepStats {
+        let (n, da) = (batch.len, self.dims.action);
+        let x = self.inputs(&batch.observation, &batch.goal, n, &self.plain);
+        let target: Tensor<2> = Tensor::from_data(self.targets(batch).into_data(), &self.device);
 
         let x: Tensor<2> = Tensor::from_data(x.into_data(), &self.device);
         let action: Tensor<2> =

@@ -21,6 +21,9 @@ pub struct Episode {
     pub achieved_goal: Vec<f64>,
     pub desired_goal: Vec<f64>,
     pub action: Vec<f32>,
+    /// The episode ended early in an absorbing failure (the object dropped or the physics
+    /// blew up), not by running out of steps.
+    pub terminated: bool,
 }
 
 pub struct HerBuffer {
@@ -128,6 +131,10 @@ impl HerBuffer {
             batch
                 .action
                 .extend_from_slice(&episode.action[t * dact..(t + 1) * dact]);
+            let last = t + 1 == episode.len;
+            batch
+                .terminal
+                .push(if episode.terminated && last { 1.0 } else { 0.0 });
         }
         batch
     }
@@ -168,6 +175,7 @@ mod tests {
             achieved_goal: (0..=len).map(|t| t as f64).collect(),
             desired_goal: vec![desired; len],
             action: vec![0.0; len],
+            terminated: false,
         }
     }
 
@@ -200,6 +208,30 @@ mod tests {
             assert_eq!(r, if (o + 1.0 - g).abs() < 0.5 { 0.0 } else { -1.0 });
         }
         assert!(batch.reward.contains(&0.0), "hindsight makes successes");
+        assert!(
+            batch.terminal.iter().all(|&d| d == 0.0),
+            "it ran its course"
+        );
+    }
+
+    #[test]
+    fn only_the_last_step_of_a_dropped_episode_is_terminal() {
+        let dims = Dims {
+            observation: 1,
+            goal: 1,
+            action: 1,
+        };
+        let mut buffer = HerBuffer::new(dims, 1000, 0.8, Arc::new(LayerGoal::default()));
+        buffer.store(Episode {
+            terminated: true,
+            ..counting_episode(6, 100.0)
+        });
+        let batch = buffer.sample(600, &mut ChaCha8Rng::seed_from_u64(2));
+        for i in 0..batch.len {
+            let last = batch.next_observation[i] == 6.0;
+            assert_eq!(batch.terminal[i], if last { 1.0 } else { 0.0 }, "row {i}");
+        }
+        assert!(batch.terminal.contains(&1.0));
     }
 
     #[test]

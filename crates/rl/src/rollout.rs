@@ -76,6 +76,7 @@ pub fn rollout<E: GoalEnv>(
                 stats.steps += 1;
                 if t.terminated || t.truncated {
                     done[i] = true;
+                    e.terminated = t.terminated;
                     stats.successes += t.info.is_success as usize;
                 }
             }

@@ -48,8 +48,9 @@ fn autodiff_matches_finite_differences() {
     }
 }
 
-#[test]
-fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
+/// An agent with 4 observations, 2 goal and 2 action dimensions, two hidden layers of 16,
+/// and batches of 8.
+fn small_agent(seed: u64) -> (Agent, DdpgHerConfig) {
     let dims = Dims {
         observation: 4,
         goal: 2,
@@ -60,7 +61,15 @@ fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
         batch_size: 8,
         ..DdpgHerConfig::default()
     };
-    let mut agent = Agent::new(dims, config, &Device::flex(), 1);
+    (
+        Agent::new(dims, config.clone(), &Device::flex(), seed),
+        config,
+    )
+}
+
+#[test]
+fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
+    let (mut agent, _) = small_agent(1);
     let batch = Batch {
         len: 8,
         observation: (0..32).map(|i| (i as f64 * 0.37).sin()).collect(),
@@ -68,6 +77,7 @@ fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
         action: (0..16).map(|i| ((i as f32) * 0.2).sin()).collect(),
         reward: vec![-1.0; 8],
         next_observation: (0..32).map(|i| (i as f64 * 0.41).cos()).collect(),
+        terminal: vec![0.0; 8],
     };
     let [actor0, _, target0, _] = agent.networks();
     for _ in 0..3 {
@@ -101,4 +111,30 @@ fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
     // The targets are plain-device snapshots: no parameter of theirs requires a gradient.
     assert!(!critic1.is_empty() && !target_critic1.is_empty());
     assert!(agent.targets_track_no_gradients());
+}
+
+#[test]
+fn a_dropped_object_is_worth_the_floor_and_other_steps_bootstrap() {
+    let (agent, config) = small_agent(2);
+    let n = 6;
+    let batch = Batch {
+        len: n,
+        observation: (0..n * 4).map(|i| (i as f64 * 0.3).sin()).collect(),
+        goal: (0..n * 2).map(|i| (i as f64 * 0.7).cos()).collect(),
+        action: vec![0.1; n * 2],
+        reward: vec![-1.0, 0.0, -1.0, 0.0, -1.0, 0.0],
+        next_observation: (0..n * 4).map(|i| (i as f64 * 0.5).cos()).collect(),
+        terminal: vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+    };
+    let y = agent.td_targets(&batch);
+    let floor = -config.clip_return() as f32;
+    assert_eq!(
+        &y[..2],
+        &[floor, floor],
+        "a drop fails forever, whatever the goal"
+    );
+    // A fresh critic's Q' is near 0, so a bootstrapped target is near the reward.
+    for (i, &r) in batch.reward.iter().enumerate().skip(2) {
+        assert!((y[i] - r).abs() < 0.5, "row {i}: {} from reward {r}", y[i]);
+    }
 }
