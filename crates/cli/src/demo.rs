@@ -85,10 +85,15 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
                 plan.len(),
                 format_moves(plan)
             ),
-            Event::Stage1 { face, attempt, ok } => {
+            Event::Stage1 {
+                face,
+                landed,
+                attempt,
+                ok,
+            } => {
                 format!(
-                    "  Stage 1: bring {face} up (attempt {attempt}) {}",
-                    if *ok { "- pose reached" } else { "- pose off" }
+                    "  Stage 1: bring {face} up (attempt {attempt}) - {landed} up, {}",
+                    if *ok { "pose reached" } else { "pose off" }
                 )
             }
             Event::Stage2 { turn, of } => {

@@ -19,7 +19,7 @@ use dexcube_sim::{Pose, Sim};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::stages::{Stage1, Stage2, randomise_pose, stage1_target};
+use crate::stages::{Stage1, Stage2, face_up, randomise_pose, stage1_target};
 
 /// Why an attempt ended without a solved cube.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -53,7 +53,10 @@ pub struct Outcome {
 pub enum Event {
     Plan(Vec<Move>),
     Stage1 {
+        /// The face the move needs on top.
         face: Face,
+        /// The face on top when Stage 1 ended (the opposite one also serves in pair mode).
+        landed: Face,
         attempt: usize,
         ok: bool,
     },
@@ -206,6 +209,7 @@ impl Operator<'_> {
             let ok = (self.stage1_accepts)(sim, self.resting, target);
             narrate(&Event::Stage1 {
                 face: up,
+                landed: face_up(sim),
                 attempt,
                 ok,
             });
