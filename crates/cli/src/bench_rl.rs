@@ -115,6 +115,7 @@ pub fn run(args: RlArgs) -> anyhow::Result<ExitCode> {
         out_dir: None,
         resume: false,
         init_from: None,
+        snapshot_every: 0,
         progress: false,
         label: "bench".into(),
         metadata: serde_json::json!({}),

@@ -52,6 +52,9 @@ pub struct TrainArgs {
     /// goals uniform over it (HER still relabels with the angles reached on the way).
     #[arg(long)]
     quarter_goals: bool,
+    /// Keep the policy of every this many epochs under DIR/snapshots (0: none).
+    #[arg(long, default_value_t = 5)]
+    snapshot_every: usize,
     /// Optimisation batches per cycle (HER baselines: 40).
     #[arg(long, default_value_t = 40)]
     batches: usize,
@@ -101,6 +104,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         out_dir: Some(out.clone()),
         resume,
         init_from: args.init.clone(),
+        snapshot_every: args.snapshot_every,
         progress: true,
         label: args.choice.name(),
         metadata: serde_json::json!({

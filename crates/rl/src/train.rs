@@ -10,6 +10,9 @@
 //!   test: networks and normalisers carry over, everything else starts afresh.
 //! - `best.safetensors` + `best.json`: the policy with the highest test success so far.
 //! - `policy.safetensors` + `policy.json`: the latest policy.
+//! - `snapshots/epoch-NNNN.safetensors` + `.json`: the policy every `snapshot_every` epochs.
+//!   DDPG can collapse suddenly, and the best epoch by a dozen test episodes is a noisy pick:
+//!   snapshots keep the candidates for a proper evaluation (`dexcube eval-stage`).
 //! - `metrics.csv` and `success.png`: the learning curve.
 //!
 //! Every random choice comes from the seed: environment `i` of the `k`-th batch of episodes
@@ -48,6 +51,8 @@ pub struct TrainOptions {
     /// Warm start: take the networks and normalisers of the run in this folder (its
     /// `checkpoint/`), then train as a new run. Only the sizes must match.
     pub init_from: Option<PathBuf>,
+    /// Keep the policy of every this many epochs under `snapshots/` (0: none).
+    pub snapshot_every: usize,
     /// Show a progress bar with ETA on stderr.
     pub progress: bool,
     /// What is being trained, for plots and policy cards.
@@ -348,7 +353,12 @@ fn save_epoch(
     let metadata = card_metadata(options, metrics);
     Policy::save(agent, &dir.join("policy"), metadata.clone())?;
     if improved {
-        Policy::save(agent, &dir.join("best"), metadata)?;
+        Policy::save(agent, &dir.join("best"), metadata.clone())?;
+    }
+    let epochs = metrics.len();
+    if options.snapshot_every > 0 && epochs % options.snapshot_every == 0 {
+        let name = format!("snapshots/epoch-{:04}", epochs - 1);
+        Policy::save(agent, &dir.join(name), metadata)?;
     }
     let csv: Vec<String> = std::iter::once(CSV_HEADER.to_string())
         .chain(metrics.iter().map(EpochMetrics::csv_row))

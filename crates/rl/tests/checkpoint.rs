@@ -24,6 +24,7 @@ fn options(dir: &std::path::Path, epochs: usize, resume: bool) -> TrainOptions {
         out_dir: Some(dir.to_path_buf()),
         resume,
         init_from: None,
+        snapshot_every: 2,
         progress: false,
         label: "point mass".into(),
         metadata: serde_json::json!({"env": "point mass"}),
@@ -47,6 +48,8 @@ fn a_run_writes_its_files_and_resumes_where_it_stopped() {
         "policy.safetensors",
         "metrics.csv",
         "success.png",
+        "snapshots/epoch-0001.safetensors",
+        "snapshots/epoch-0001.json",
     ] {
         assert!(dir.join(file).is_file(), "{file} written");
     }

@@ -26,6 +26,7 @@ fn options(epochs: usize) -> TrainOptions {
         out_dir: None,
         resume: false,
         init_from: None,
+        snapshot_every: 0,
         progress: false,
         label: "point mass".into(),
         metadata: serde_json::json!({}),
