@@ -356,7 +356,7 @@ fn save_epoch(
         Policy::save(agent, &dir.join("best"), metadata.clone())?;
     }
     let epochs = metrics.len();
-    if options.snapshot_every > 0 && epochs % options.snapshot_every == 0 {
+    if options.snapshot_every > 0 && epochs.is_multiple_of(options.snapshot_every) {
         let name = format!("snapshots/epoch-{:04}", epochs - 1);
         Policy::save(agent, &dir.join(name), metadata)?;
     }
