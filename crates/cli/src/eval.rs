@@ -113,6 +113,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     };
     let table_all = DistanceTable::build();
     let csv = args.out.with_extension("csv");
+    check_same_run(&args.out, &files, args.seed)?;
     let mut results: Vec<CubeResult> = std::fs::read_to_string(&csv)
         .map(|text| {
             text.lines()
@@ -251,6 +252,46 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     }
     print!("{}", markdown(&rows, &command));
     Ok(ExitCode::SUCCESS)
+}
+
+/// A 64-bit FNV-1a fingerprint of a file's bytes.
+fn fingerprint(path: &Path) -> anyhow::Result<String> {
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("reading {} to fingerprint it", path.display()))?;
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    Ok(format!("{hash:016x}"))
+}
+
+/// A rerun may only continue PREFIX.csv if it was made with the same policies (by content)
+/// and seed; PREFIX.run.json records them. More cubes per distance, or more distances, are
+/// fine: scrambles at a seed are prefix-stable.
+fn check_same_run(out: &Path, files: &PolicyFiles, seed: u64) -> anyhow::Result<()> {
+    let identity = serde_json::json!({
+        "seed": seed,
+        "rot_policy": fingerprint(&files.rot.with_extension("safetensors"))?,
+        "layer_policy": fingerprint(&files.layer.with_extension("safetensors"))?,
+    });
+    let (csv, sidecar) = (out.with_extension("csv"), out.with_extension("run.json"));
+    if csv.exists() {
+        let before: Option<serde_json::Value> = std::fs::read_to_string(&sidecar)
+            .ok()
+            .and_then(|text| serde_json::from_str(&text).ok());
+        if before.as_ref() != Some(&identity) {
+            bail!(
+                "{} holds results of other policies or another seed (see {}); pass another --out, \
+                 or delete it to start again",
+                csv.display(),
+                sidecar.display()
+            );
+        }
+    }
+    write_atomically(
+        &sidecar,
+        serde_json::to_string_pretty(&identity)?.as_bytes(),
+    )?;
+    Ok(())
 }
 
 #[derive(Clone, Copy, ValueEnum)]

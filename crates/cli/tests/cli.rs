@@ -201,6 +201,17 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
         "{}",
         stderr(&again)
     );
+    // Continuing it with another seed would mix two runs in one table: refused.
+    let other_seed: Vec<&str> = args
+        .iter()
+        .map(|&a| if a == "5" { "6" } else { a })
+        .collect();
+    let refused = dexcube(&other_seed, "");
+    assert_clean_failure(
+        &refused,
+        2,
+        "holds results of other policies or another seed",
+    );
 }
 
 #[test]
