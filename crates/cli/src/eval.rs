@@ -4,8 +4,8 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
@@ -170,8 +170,6 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     let scene = Scene::load(SceneKind::Cube)?;
     let resting = dexcube_operator::eval::resting_point()?;
     let shared = Mutex::new(std::mem::take(&mut results));
-    let next = AtomicUsize::new(0);
-    let jobs = Arc::new(jobs);
     let save = |results: &[CubeResult]| -> anyhow::Result<()> {
         let mut sorted = results.to_vec();
         sorted.sort_by_key(|r| (!r.rollback, r.distance, r.index));
@@ -186,64 +184,41 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         )?;
         Ok(())
     };
-    let failures: Mutex<Option<anyhow::Error>> = Mutex::new(None);
-    std::thread::scope(|s| {
-        for _ in 0..args.threads.max(1) {
-            s.spawn(|| {
-                let mut stages = match files.load(resting) {
-                    Ok(stages) => stages,
-                    Err(e) => {
-                        failures.lock().expect("lock").replace(e.into());
-                        return;
-                    }
-                };
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some((d, i, rollback, moves)) = jobs.get(k) else {
-                        break;
-                    };
-                    let seed =
-                        args.seed ^ ((*d as u64) << 40) ^ ((*i as u64) << 8) ^ (*rollback as u64);
-                    let hooks = Hooks {
-                        watch: &mut |_| {},
-                        narrate: &mut |_| {},
-                    };
-                    let outcome = run_cube(
-                        &mut stages,
-                        &scene,
-                        &table_all,
-                        (moves, *rollback, seed),
-                        hooks,
-                    );
-                    let row = CubeResult {
-                        distance: *d,
-                        index: *i,
-                        rollback: *rollback,
-                        solved: outcome.solved,
-                        actions: outcome.actions,
-                        randomisations: outcome.randomisations,
-                        replans: outcome.replans,
-                        control_steps: outcome.control_steps,
-                        failure: outcome.failure.map_or(String::new(), |f| format!("{f:?}")),
-                    };
-                    let mut all = shared.lock().expect("lock");
-                    all.push(row);
-                    // Every finished cube is on disk at once: a killed run loses at most the
-                    // cubes under way.
-                    if let Err(e) = save(&all) {
-                        failures.lock().expect("lock").replace(e);
-                    }
-                    let solved = all.iter().filter(|r| r.solved).count();
-                    bar.set_message(format!("solved {solved}/{}", all.len()));
-                    bar.inc(1);
-                }
-            });
-        }
-    });
+    let done = in_parallel(
+        args.threads,
+        jobs.len(),
+        || Ok(files.load(resting)?),
+        |stages, k| {
+            let (d, i, rollback, moves) = &jobs[k];
+            let seed = args.seed ^ ((*d as u64) << 40) ^ ((*i as u64) << 8) ^ (*rollback as u64);
+            let hooks = Hooks {
+                watch: &mut |_| {},
+                narrate: &mut |_| {},
+            };
+            let outcome = run_cube(stages, &scene, &table_all, (moves, *rollback, seed), hooks);
+            let row = CubeResult {
+                distance: *d,
+                index: *i,
+                rollback: *rollback,
+                solved: outcome.solved,
+                actions: outcome.actions,
+                randomisations: outcome.randomisations,
+                replans: outcome.replans,
+                control_steps: outcome.control_steps,
+                failure: outcome.failure.map_or(String::new(), |f| format!("{f:?}")),
+            };
+            let mut all = shared.lock().expect("lock");
+            all.push(row);
+            let solved = all.iter().filter(|r| r.solved).count();
+            bar.set_message(format!("solved {solved}/{}", all.len()));
+            bar.inc(1);
+            // Every finished cube is on disk at once: a killed run loses at most the cubes
+            // under way.
+            save(&all)
+        },
+    );
     bar.finish();
-    if let Some(e) = failures.into_inner().expect("lock") {
-        return Err(e);
-    }
+    done?;
     let results = shared.into_inner().expect("lock");
     save(&results)?;
     let rows = table(&results, &distances);
@@ -252,6 +227,38 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     }
     print!("{}", markdown(&rows, &command));
     Ok(ExitCode::SUCCESS)
+}
+
+/// Runs `work(state, k)` for every k in 0..n on `threads` threads. Each thread makes its own
+/// state with `init` (a policy, an environment) and takes the next k as it frees up. The
+/// first error is returned once every thread has stopped.
+fn in_parallel<S>(
+    threads: usize,
+    n: usize,
+    init: impl Fn() -> anyhow::Result<S> + Sync,
+    work: impl Fn(&mut S, usize) -> anyhow::Result<()> + Sync,
+) -> anyhow::Result<()> {
+    let next = AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads.max(1))
+            .map(|_| {
+                s.spawn(|| -> anyhow::Result<()> {
+                    let mut state = init()?;
+                    loop {
+                        let k = next.fetch_add(1, Ordering::Relaxed);
+                        if k >= n {
+                            return Ok(());
+                        }
+                        work(&mut state, k)?;
+                    }
+                })
+            })
+            .collect();
+        handles.into_iter().try_for_each(|h| {
+            h.join()
+                .map_err(|_| anyhow::anyhow!("an evaluation thread panicked"))?
+        })
+    })
 }
 
 /// A 64-bit FNV-1a fingerprint of a file's bytes.
@@ -353,17 +360,15 @@ impl Ending {
     }
 
     fn of(info: &Info, (position, angle): (f64, f64)) -> Ending {
-        let (p, a) = (info.position_error >= position, info.angle_error >= angle);
-        match (
-            info.is_success,
-            info.dropped || info.physics_error.is_some(),
-            p,
-            a,
-        ) {
-            (true, ..) => Ending::Success,
-            (_, true, ..) => Ending::Dropped,
-            (_, _, true, false) => Ending::PositionOff,
-            (_, _, false, true) => Ending::AngleOff,
+        if info.is_success {
+            return Ending::Success;
+        }
+        if info.dropped || info.physics_error.is_some() {
+            return Ending::Dropped;
+        }
+        match (info.position_error >= position, info.angle_error >= angle) {
+            (true, false) => Ending::PositionOff,
+            (false, true) => Ending::AngleOff,
             _ => Ending::BothOff,
         }
     }
@@ -387,7 +392,6 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         StageKind::Rot => files.rot.clone(),
         StageKind::Layer => files.layer.clone(),
     };
-    let next = AtomicUsize::new(0);
     let endings: [AtomicUsize; 5] = Default::default();
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
@@ -399,36 +403,28 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         StageKind::Rot => SceneKind::Rot,
         StageKind::Layer => SceneKind::Layer,
     })?;
-    std::thread::scope(|s| -> anyhow::Result<()> {
-        let mut handles = Vec::new();
-        for _ in 0..args.threads.max(1) {
-            handles.push(s.spawn(|| -> anyhow::Result<()> {
-                let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
-                let mut env: Box<dyn GoalEnv> = match args.stage {
-                    StageKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
-                    StageKind::Layer => Box::new(LayerOpEnv::with_scene(
-                        scene.clone(),
-                        LayerMove::UPrime,
-                        LayerGoals::Evaluation,
-                    )),
-                };
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    if k >= args.episodes {
-                        return Ok(());
-                    }
-                    let info = episode(env.as_mut(), &policy, args.seed + k as u64);
-                    endings[Ending::of(&info, thresholds) as usize].fetch_add(1, Ordering::Relaxed);
-                    bar.inc(1);
-                }
-            }));
-        }
-        for h in handles {
-            h.join()
-                .map_err(|_| anyhow::anyhow!("an evaluation thread panicked"))??;
-        }
-        Ok(())
-    })?;
+    in_parallel(
+        args.threads,
+        args.episodes,
+        || -> anyhow::Result<(Policy, Box<dyn GoalEnv>)> {
+            let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
+            let env: Box<dyn GoalEnv> = match args.stage {
+                StageKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
+                StageKind::Layer => Box::new(LayerOpEnv::with_scene(
+                    scene.clone(),
+                    LayerMove::UPrime,
+                    LayerGoals::Evaluation,
+                )),
+            };
+            Ok((policy, env))
+        },
+        |(policy, env), k| {
+            let info = episode(env.as_mut(), policy, args.seed + k as u64);
+            endings[Ending::of(&info, thresholds) as usize].fetch_add(1, Ordering::Relaxed);
+            bar.inc(1);
+            Ok(())
+        },
+    )?;
     bar.finish_and_clear();
     let counts = endings.map(AtomicUsize::into_inner);
     let wins = counts[Ending::Success as usize];

@@ -72,6 +72,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     if envs == 0 || threads == 0 || args.epochs == 0 {
         bail!("--envs, --threads and --epochs must be at least 1");
     }
+    if args.quarter_goals && matches!(args.choice.env, EnvKind::Rot) {
+        bail!("--quarter-goals is for LayerOpEnv (train layer)");
+    }
     let (name, variant) = match args.choice.env {
         EnvKind::Rot => ("rot", args.choice.mode.name().to_string()),
         EnvKind::Layer => (
@@ -80,9 +83,6 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 + if args.quarter_goals { "-quarter" } else { "" },
         ),
     };
-    if args.quarter_goals && matches!(args.choice.env, EnvKind::Rot) {
-        bail!("--quarter-goals is for LayerOpEnv (train layer)");
-    }
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
         (Some(dir), None) => (dir.clone(), false),

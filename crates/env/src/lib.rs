@@ -26,7 +26,7 @@ pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{DROP_DEPTH, base_observation, is_dropped, resting_point};
 pub use layer::{LayerMove, LayerOpEnv};
-pub use rot::CubeRotEnv;
+pub use rot::{CubeRotEnv, pose_goal};
 pub use vec_env::VecEnv;
 
 /// Control steps in an episode (the paper's 100).

@@ -60,7 +60,7 @@ impl CubeRotEnv {
     /// A CubeRotEnv over an already loaded `rot` scene (shared between environments).
     pub fn with_scene(scene: Arc<Scene>, goal: RotGoal) -> CubeRotEnv {
         let hand = HandObject::new(scene);
-        let desired = target(hand.resting, PAPER_TARGETS[0]);
+        let desired = pose_goal(hand.resting, PAPER_TARGETS[0]);
         CubeRotEnv {
             hand,
             goal: Arc::new(goal),
@@ -111,7 +111,8 @@ fn observe(hand: &HandObject, desired: &[f64]) -> Observation {
     }
 }
 
-fn target(position: [f64; 3], orientation: Quat) -> Vec<f64> {
+/// A pose as CubeRotEnv's goal vector: position, then the quaternion with w ≥ 0.
+pub fn pose_goal(position: [f64; 3], orientation: Quat) -> Vec<f64> {
     position
         .iter()
         .chain(canonical(orientation).iter())
@@ -146,7 +147,7 @@ impl GoalEnv for CubeRotEnv {
         self.hand.seed(seed);
         self.hand.place(uniform_rotation);
         let pick = self.hand.rng.random_range(0..PAPER_TARGETS.len());
-        self.desired = target(self.hand.resting, PAPER_TARGETS[pick]);
+        self.desired = pose_goal(self.hand.resting, PAPER_TARGETS[pick]);
         self.show_target();
         let observation = self.observe();
         let info = self.hand.info(&observation, self.goal.as_ref(), None);

@@ -235,81 +235,69 @@ pub fn markdown(rows: &[TableRow], command: &str) -> String {
     out
 }
 
-/// Draws SR and AN against move distance, ours and the paper's, into a PNG.
+/// Draws SR and AN against move distance, ours and the paper's, into PREFIX-sr.png and
+/// PREFIX-an.png beside `path`.
 pub fn plot(rows: &[TableRow], path: &Path) -> Result<(), String> {
     use dexcube_rl::plot::{Series, line_plot};
-    let series = |f: &dyn Fn(&TableRow) -> f64,
-                  paper: &[f64; 14],
-                  label: &str,
-                  want: &dyn Fn(&TableRow) -> bool| {
-        [
-            Series {
-                label: format!("{label} (ours)"),
-                points: rows
-                    .iter()
-                    .filter(|r| want(r))
-                    .map(|r| (r.distance as f64, f(r)))
-                    .collect(),
-                band: None,
-            },
-            Series {
-                label: format!("{label} (paper)"),
-                points: rows
-                    .iter()
-                    .map(|r| (r.distance as f64, paper[r.distance - 1]))
-                    .collect(),
-                band: None,
-            },
-        ]
+    type Measure = fn(&TableRow) -> f64;
+    type Cubes = fn(&TableRow) -> usize;
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("table");
+    // Ours (for distances with cubes) and the paper's, with rollback and open loop.
+    let curves = |name: &str, ours: [Measure; 2], paper: [&[f64; 14]; 2]| -> Vec<Series> {
+        let variants: [(&str, Cubes); 2] = [
+            ("rollback", |r| r.cubes_rollback),
+            ("open loop", |r| r.cubes_open_loop),
+        ];
+        variants
+            .into_iter()
+            .zip(ours.into_iter().zip(paper))
+            .flat_map(|((variant, cubes), (ours, paper))| {
+                [
+                    Series {
+                        label: format!("{name} {variant} (ours)"),
+                        points: rows
+                            .iter()
+                            .filter(|r| cubes(r) > 0)
+                            .map(|r| (r.distance as f64, ours(r)))
+                            .collect(),
+                        band: None,
+                    },
+                    Series {
+                        label: format!("{name} {variant} (paper)"),
+                        points: rows
+                            .iter()
+                            .map(|r| (r.distance as f64, paper[r.distance - 1]))
+                            .collect(),
+                        band: None,
+                    },
+                ]
+            })
+            .collect()
     };
-    let mut sr: Vec<Series> = series(
-        &|r| r.sr_rollback,
-        &PAPER_SR_ROLLBACK,
-        "SR rollback",
-        &|r| r.cubes_rollback > 0,
-    )
-    .into();
-    sr.extend(series(
-        &|r| r.sr_open_loop,
-        &PAPER_SR_OPEN_LOOP,
-        "SR open loop",
-        &|r| r.cubes_open_loop > 0,
-    ));
-    let sr_path = path.with_file_name(format!(
-        "{}-sr.png",
-        path.file_stem().and_then(|s| s.to_str()).unwrap_or("table")
-    ));
+    let sr = curves(
+        "SR",
+        [|r| r.sr_rollback, |r| r.sr_open_loop],
+        [&PAPER_SR_ROLLBACK, &PAPER_SR_OPEN_LOOP],
+    );
     line_plot(
-        &sr_path,
+        &path.with_file_name(format!("{stem}-sr.png")),
         "Success rate by move distance",
         "move distance",
         "success rate",
         1.05,
         &sr,
     )?;
-    let mut an: Vec<Series> = series(
-        &|r| r.an_rollback,
-        &PAPER_AN_ROLLBACK,
-        "AN rollback",
-        &|r| r.cubes_rollback > 0,
-    )
-    .into();
-    an.extend(series(
-        &|r| r.an_open_loop,
-        &PAPER_AN_OPEN_LOOP,
-        "AN open loop",
-        &|r| r.cubes_open_loop > 0,
-    ));
+    let an = curves(
+        "AN",
+        [|r| r.an_rollback, |r| r.an_open_loop],
+        [&PAPER_AN_ROLLBACK, &PAPER_AN_OPEN_LOOP],
+    );
     let an_max = rows
         .iter()
         .map(|r| r.an_rollback.max(r.an_open_loop))
         .fold(45.0, f64::max);
-    let an_path = path.with_file_name(format!(
-        "{}-an.png",
-        path.file_stem().and_then(|s| s.to_str()).unwrap_or("table")
-    ));
     line_plot(
-        &an_path,
+        &path.with_file_name(format!("{stem}-an.png")),
         "Action number by move distance",
         "move distance",
         "atomic actions",

@@ -19,7 +19,7 @@ use dexcube_sim::{Pose, Sim};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::stages::{Stage1, Stage2, face_up, randomise_pose, stage1_target};
+use crate::stages::{Stage1, Stage2, StageRun, face_up, randomise_pose, stage1_target};
 
 /// Why an attempt ended without a solved cube.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -37,7 +37,7 @@ pub enum Failure {
 }
 
 /// What happened in one attempt.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
     pub solved: bool,
     pub failure: Option<Failure>,
@@ -46,6 +46,21 @@ pub struct Outcome {
     pub randomisations: usize,
     pub replans: usize,
     pub control_steps: usize,
+}
+
+impl Outcome {
+    /// Counts one atomic action; a dropped cube or a blow-up ends the attempt.
+    fn count(&mut self, run: &StageRun) -> Option<Failure> {
+        self.actions += 1;
+        self.control_steps += run.steps;
+        if run.dropped {
+            Some(Failure::Dropped)
+        } else if run.diverged {
+            Some(Failure::Diverged)
+        } else {
+            None
+        }
+    }
 }
 
 /// Something the operator did, for narration.
@@ -124,14 +139,7 @@ pub struct Operator<'a> {
 impl Operator<'_> {
     /// Solves the cube in `sim`, reporting each event to `narrate`.
     pub fn solve(&mut self, sim: &mut Sim, narrate: &mut dyn FnMut(&Event)) -> Outcome {
-        let mut outcome = Outcome {
-            solved: false,
-            failure: None,
-            actions: 0,
-            randomisations: 0,
-            replans: 0,
-            control_steps: 0,
-        };
+        let mut outcome = Outcome::default();
         let Some(start) = read(sim) else {
             outcome.failure = Some(Failure::StuckMisaligned);
             return outcome;
@@ -197,14 +205,8 @@ impl Operator<'_> {
         let target = stage1_target(up);
         for attempt in 1..=self.config.stage1_attempts {
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
-            outcome.actions += 1;
-            outcome.control_steps += run.steps;
-            if run.dropped || run.diverged {
-                return Some(if run.dropped {
-                    Failure::Dropped
-                } else {
-                    Failure::Diverged
-                });
+            if let Some(failure) = outcome.count(&run) {
+                return Some(failure);
             }
             let ok = (self.stage1_accepts)(sim, self.resting, target);
             narrate(&Event::Stage1 {
@@ -224,15 +226,10 @@ impl Operator<'_> {
         }
         for turn in 1..=turns {
             let run = self.stage2.run(sim, &mut *self.watch);
-            outcome.actions += 1;
-            outcome.control_steps += run.steps;
+            let failure = outcome.count(&run);
             narrate(&Event::Stage2 { turn, of: turns });
-            if run.dropped || run.diverged {
-                return Some(if run.dropped {
-                    Failure::Dropped
-                } else {
-                    Failure::Diverged
-                });
+            if failure.is_some() {
+                return failure;
             }
             if self.config.rollback {
                 let mut restores = 0;

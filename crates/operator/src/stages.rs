@@ -7,7 +7,9 @@ use std::f64::consts::FRAC_PI_2;
 
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
-use dexcube_env::{EPISODE_STEPS, Goal, RotGoal, RotMode, base_observation, is_dropped};
+use dexcube_env::{
+    EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, base_observation, is_dropped, pose_goal,
+};
 use dexcube_rl::Policy;
 use dexcube_sim::cube::{CubeState, face_normal, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
@@ -90,7 +92,7 @@ pub struct PolicyStage1 {
 
 impl Stage1 for PolicyStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
-        let goal: Vec<f64> = position.iter().chain(target.iter()).copied().collect();
+        let goal = pose_goal(position, target);
         let reached = pose_reached(self.mode);
         let policy = &self.policy;
         drive(
@@ -131,16 +133,10 @@ impl Stage2 for PolicyStage2 {
         let policy = &self.policy;
         let mut angle = move |sim: &Sim| {
             let now = read(sim);
-            // Quarter-turn readings wrap at ±45°: accumulate the change instead.
-            let mut change = now - last;
-            while change > std::f64::consts::FRAC_PI_4 {
-                change -= FRAC_PI_2;
-            }
-            while change < -std::f64::consts::FRAC_PI_4 {
-                change += FRAC_PI_2;
-            }
+            // Quarter-turn readings wrap at ±45°: accumulate the change, brought into ±45°.
+            let change = now - last;
+            total += change - FRAC_PI_2 * (change / FRAC_PI_2).round();
             last = now;
-            total += change;
             total
         };
         let latest = std::cell::Cell::new(0.0);
@@ -152,7 +148,7 @@ impl Stage2 for PolicyStage2 {
                 observation.push(latest.get());
                 policy.act(&observation, &goal)
             },
-            |_| (latest.get() - FRAC_PI_2).abs() < 0.1,
+            |_| LayerGoal::default().is_success(&[latest.get()], &goal),
             self.resting_z,
             watch,
         )
@@ -208,14 +204,10 @@ pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
 /// the physical cube's pose.
 pub fn pose_reached(mode: RotMode) -> impl Fn(&Sim, [f64; 3], Quat) -> bool {
     move |sim, position, target| {
-        let p = sim.object_pose();
-        let achieved: Vec<f64> = p
-            .position
-            .iter()
-            .chain(p.orientation.iter())
-            .copied()
-            .collect();
-        let goal: Vec<f64> = position.iter().chain(target.iter()).copied().collect();
-        RotGoal::paper(mode).is_success(&achieved, &goal)
+        let pose = sim.object_pose();
+        RotGoal::paper(mode).is_success(
+            &pose_goal(pose.position, pose.orientation),
+            &pose_goal(position, target),
+        )
     }
 }

@@ -108,79 +108,51 @@ fn an_off_pose_after_stage_1_is_randomised_and_retried() {
     assert_eq!(outcome.randomisations, 1);
 }
 
-/// A Stage 2 that over-turns by 25° on its first run, then turns right.
-struct SloppyStage2 {
-    sloppy: bool,
+/// A Stage 2 whose first run turns the top layer by `first`, and every later run by U'.
+struct WrongFirstTurn {
+    first: Option<f64>,
 }
 
-impl Stage2 for SloppyStage2 {
+impl Stage2 for WrongFirstTurn {
     fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let extra = if std::mem::take(&mut self.sloppy) {
-            25f64.to_radians()
-        } else {
-            0.0
-        };
         KinematicStage2 {
-            angle: U_PRIME + extra,
+            angle: self.first.take().unwrap_or(U_PRIME),
         }
         .run(sim, watch)
+    }
+}
+
+/// Over-turns by 25° once.
+fn sloppy_once() -> WrongFirstTurn {
+    WrongFirstTurn {
+        first: Some(U_PRIME + 25f64.to_radians()),
+    }
+}
+
+/// Turns the wrong way once.
+fn backwards_once() -> WrongFirstTurn {
+    WrongFirstTurn {
+        first: Some(-U_PRIME),
     }
 }
 
 #[test]
 fn a_misaligned_cube_after_stage_2_is_restored_to_a_good_state() {
-    let outcome = attempt(
-        &mut KinematicStage1,
-        &mut SloppyStage2 { sloppy: true },
-        true,
-        3,
-        5,
-    );
+    let outcome = attempt(&mut KinematicStage1, &mut sloppy_once(), true, 3, 5);
     assert!(outcome.solved, "{outcome:?}");
     assert!(outcome.randomisations >= 1, "{outcome:?}");
 }
 
-/// A Stage 2 that turns the wrong way on its first run.
-struct BackwardsOnce {
-    backwards: bool,
-}
-
-impl Stage2 for BackwardsOnce {
-    fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let sign = if std::mem::take(&mut self.backwards) {
-            -1.0
-        } else {
-            1.0
-        };
-        KinematicStage2 {
-            angle: sign * U_PRIME,
-        }
-        .run(sim, watch)
-    }
-}
-
 #[test]
 fn a_move_that_did_not_happen_is_caught_and_replanned() {
-    let outcome = attempt(
-        &mut KinematicStage1,
-        &mut BackwardsOnce { backwards: true },
-        true,
-        5,
-        6,
-    );
+    let outcome = attempt(&mut KinematicStage1, &mut backwards_once(), true, 5, 6);
     assert!(outcome.solved, "{outcome:?}");
     assert!(outcome.replans >= 1, "{outcome:?}");
 }
 
 #[test]
 fn without_rollback_the_same_mistake_is_not_recovered() {
-    let outcome = attempt(
-        &mut KinematicStage1,
-        &mut BackwardsOnce { backwards: true },
-        false,
-        5,
-        6,
-    );
+    let outcome = attempt(&mut KinematicStage1, &mut backwards_once(), false, 5, 6);
     assert!(!outcome.solved);
     assert_eq!(outcome.failure, Some(Failure::NotSolved));
     assert_eq!(outcome.replans, 0);

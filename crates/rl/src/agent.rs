@@ -181,10 +181,8 @@ impl Agent {
     /// One optimisation step of actor and critic on `batch`.
     pub fn train(&mut self, batch: &Batch) -> StepStats {
         let (n, da) = (batch.len, self.dims.action);
-        let x = self.inputs(&batch.observation, &batch.goal, n, &self.plain);
         let target: Tensor<2> = Tensor::from_data(self.targets(batch).into_data(), &self.device);
-
-        let x: Tensor<2> = Tensor::from_data(x.into_data(), &self.device);
+        let x = self.inputs(&batch.observation, &batch.goal, n, &self.device);
         let action: Tensor<2> =
             Tensor::from_data(TensorData::new(batch.action.clone(), [n, da]), &self.device);
         let q = self.critic.forward(Tensor::cat(vec![x.clone(), action], 1));

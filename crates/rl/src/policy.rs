@@ -40,13 +40,13 @@ pub fn policy_paths(prefix: &Path) -> (PathBuf, PathBuf) {
 }
 
 impl Policy {
-    /// Saves an agent's actor as a policy at `prefix`.
+    /// Saves an agent's actor as a policy at each of `prefixes` (the latest, the best, a
+    /// snapshot: one read of the weights serves them all).
     pub fn save(
         agent: &Agent,
-        prefix: &Path,
+        prefixes: &[PathBuf],
         metadata: serde_json::Value,
     ) -> Result<(), CheckpointError> {
-        let (weights, card_path) = policy_paths(prefix);
         let card = PolicyCard {
             dims: agent.dims,
             config: agent.config.clone(),
@@ -54,8 +54,13 @@ impl Policy {
             goal_norm: agent.goal_norm.clone(),
             metadata,
         };
-        checkpoint::save_tensors(&weights, &agent.actor_params())?;
-        checkpoint::save_json(&card_path, &card)
+        let actor = agent.actor_params();
+        for prefix in prefixes {
+            let (weights, card_path) = policy_paths(prefix);
+            checkpoint::save_tensors(&weights, &actor)?;
+            checkpoint::save_json(&card_path, &card)?;
+        }
+        Ok(())
     }
 
     /// Loads the policy at `prefix` onto `device`.

@@ -350,16 +350,15 @@ fn save_epoch(
     };
     // The state goes last: a checkpoint is complete once state.json names its epoch.
     checkpoint::save_json(&checkpoint_dir.join("state.json"), &state)?;
-    let metadata = card_metadata(options, metrics);
-    Policy::save(agent, &dir.join("policy"), metadata.clone())?;
+    let mut prefixes = vec![dir.join("policy")];
     if improved {
-        Policy::save(agent, &dir.join("best"), metadata.clone())?;
+        prefixes.push(dir.join("best"));
     }
     let epochs = metrics.len();
     if options.snapshot_every > 0 && epochs.is_multiple_of(options.snapshot_every) {
-        let name = format!("snapshots/epoch-{:04}", epochs - 1);
-        Policy::save(agent, &dir.join(name), metadata)?;
+        prefixes.push(dir.join(format!("snapshots/epoch-{:04}", epochs - 1)));
     }
+    Policy::save(agent, &prefixes, card_metadata(options, metrics))?;
     let csv: Vec<String> = std::iter::once(CSV_HEADER.to_string())
         .chain(metrics.iter().map(EpochMetrics::csv_row))
         .collect();
@@ -394,33 +393,28 @@ fn resume(
     if !checkpoint_dir.join("state.json").exists() {
         return Ok(Vec::new());
     }
-    let state = load_checkpoint(agent, &checkpoint_dir, |state, agent| {
-        if state.dims != agent.dims || state.config != agent.config {
-            return Err(TrainError::Resume(format!(
-                "{} was trained with other sizes or hyperparameters ({:?}); use a new --out folder",
-                checkpoint_dir.display(),
+    load_checkpoint(agent, &checkpoint_dir, |state, agent| {
+        let at = checkpoint_dir.display();
+        let refusal = if state.dims != agent.dims || state.config != agent.config {
+            format!(
+                "{at} was trained with other sizes or hyperparameters ({:?}); use a new --out folder",
                 state.dims
-            )));
-        }
-        if state.label != options.label {
-            return Err(TrainError::Resume(format!(
-                "{} is a run of {}, not {}; pass the same environment and mode",
-                checkpoint_dir.display(),
-                state.label,
-                options.label
-            )));
-        }
-        if state.seed != options.seed {
-            return Err(TrainError::Resume(format!(
-                "{} was trained with seed {}, not {}",
-                checkpoint_dir.display(),
-                state.seed,
-                options.seed
-            )));
-        }
-        Ok(())
-    })?;
-    Ok(state.metrics)
+            )
+        } else if state.label != options.label {
+            format!(
+                "{at} is a run of {}, not {}; pass the same environment and mode",
+                state.label, options.label
+            )
+        } else if state.seed != options.seed {
+            format!(
+                "{at} was trained with seed {}, not {}",
+                state.seed, options.seed
+            )
+        } else {
+            return Ok(());
+        };
+        Err(TrainError::Resume(refusal))
+    })
 }
 
 /// Takes the networks and normalisers of the run in `dir`, for a new run.
@@ -444,16 +438,16 @@ fn warm_start(agent: &mut Agent, dir: &Path) -> Result<(), TrainError> {
             )))
         }
     })
-    .map(|_| ())
+    .map(drop)
 }
 
-/// Loads a checkpoint's networks and normalisers into `agent`;
-/// `check` vets the saved state first.
+/// Loads a checkpoint's networks and normalisers into `agent` once `check` has vetted its
+/// saved state; returns the epochs it records.
 fn load_checkpoint(
     agent: &mut Agent,
     checkpoint_dir: &Path,
     check: impl Fn(&TrainState, &Agent) -> Result<(), TrainError>,
-) -> Result<TrainState, TrainError> {
+) -> Result<Vec<EpochMetrics>, TrainError> {
     let state: TrainState = checkpoint::load_json(&checkpoint_dir.join("state.json"))?;
     check(&state, agent)?;
     let mut networks: [Vec<crate::params::NamedTensor>; 4] = Default::default();
@@ -466,7 +460,7 @@ fn load_checkpoint(
             message: e.to_string(),
         })
     })?;
-    agent.observation_norm = state.observation_norm.clone();
-    agent.goal_norm = state.goal_norm.clone();
-    Ok(state)
+    agent.observation_norm = state.observation_norm;
+    agent.goal_norm = state.goal_norm;
+    Ok(state.metrics)
 }
