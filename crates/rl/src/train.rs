@@ -118,6 +118,9 @@ struct TrainState {
     observation_norm: Normalizer,
     goal_norm: Normalizer,
     metrics: Vec<EpochMetrics>,
+    /// The run this one was warm-started from, kept so a resumed run's cards still say so.
+    #[serde(default)]
+    init_from: Option<PathBuf>,
 }
 
 #[derive(Debug)]
@@ -180,8 +183,13 @@ pub fn train<E: GoalEnv>(
     let mut agent = Agent::new(dims, config.clone(), &Device::flex(), options.seed);
     let mut buffer = HerBuffer::new(dims, config.buffer_size, config.future_probability(), goal);
     let mut metrics: Vec<EpochMetrics> = Vec::new();
+    let mut init_from = options.init_from.clone();
     if let (true, Some(dir)) = (options.resume, &options.out_dir) {
-        metrics = resume(&mut agent, dir, options)?;
+        let resumed_from;
+        (metrics, resumed_from) = resume(&mut agent, dir, options)?;
+        if !metrics.is_empty() {
+            init_from = resumed_from;
+        }
     }
     if let (true, Some(dir)) = (metrics.is_empty(), &options.init_from) {
         warm_start(&mut agent, dir)?;
@@ -285,7 +293,14 @@ pub fn train<E: GoalEnv>(
         best = best.max(row.test_success);
         metrics.push(row);
         if let Some(dir) = &options.out_dir {
-            save_epoch(&agent, dir, options, &metrics, improved)?;
+            save_epoch(
+                &agent,
+                dir,
+                options,
+                init_from.as_deref(),
+                &metrics,
+                improved,
+            )?;
         }
     }
     bar.finish();
@@ -308,7 +323,11 @@ fn progress_bar(options: &TrainOptions, cycles: usize, done_epochs: usize) -> Pr
     bar
 }
 
-fn card_metadata(options: &TrainOptions, metrics: &[EpochMetrics]) -> serde_json::Value {
+fn card_metadata(
+    options: &TrainOptions,
+    init_from: Option<&Path>,
+    metrics: &[EpochMetrics],
+) -> serde_json::Value {
     let last = metrics.last();
     serde_json::json!({
         "label": options.label,
@@ -321,7 +340,7 @@ fn card_metadata(options: &TrainOptions, metrics: &[EpochMetrics]) -> serde_json
         "updates": last.map_or(0, |m| m.updates),
         "wall_s": last.map_or(0.0, |m| m.wall_s),
         "test_success": last.map_or(0.0, |m| m.test_success),
-        "init_from": options.init_from.as_ref().map(|d| d.display().to_string()),
+        "init_from": init_from.map(|d| d.display().to_string()),
     })
 }
 
@@ -329,6 +348,7 @@ fn save_epoch(
     agent: &Agent,
     dir: &Path,
     options: &TrainOptions,
+    init_from: Option<&Path>,
     metrics: &[EpochMetrics],
     improved: bool,
 ) -> Result<(), TrainError> {
@@ -347,6 +367,7 @@ fn save_epoch(
         observation_norm: agent.observation_norm.clone(),
         goal_norm: agent.goal_norm.clone(),
         metrics: metrics.to_vec(),
+        init_from: init_from.map(Path::to_path_buf),
     };
     // The state goes last: a checkpoint is complete once state.json names its epoch.
     checkpoint::save_json(&checkpoint_dir.join("state.json"), &state)?;
@@ -358,7 +379,7 @@ fn save_epoch(
     if options.snapshot_every > 0 && epochs.is_multiple_of(options.snapshot_every) {
         prefixes.push(dir.join(format!("snapshots/epoch-{:04}", epochs - 1)));
     }
-    Policy::save(agent, &prefixes, card_metadata(options, metrics))?;
+    Policy::save(agent, &prefixes, card_metadata(options, init_from, metrics))?;
     let csv: Vec<String> = std::iter::once(CSV_HEADER.to_string())
         .chain(metrics.iter().map(EpochMetrics::csv_row))
         .collect();
@@ -388,10 +409,10 @@ fn resume(
     agent: &mut Agent,
     dir: &Path,
     options: &TrainOptions,
-) -> Result<Vec<EpochMetrics>, TrainError> {
+) -> Result<(Vec<EpochMetrics>, Option<PathBuf>), TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), None));
     }
     load_checkpoint(agent, &checkpoint_dir, |state, agent| {
         let at = checkpoint_dir.display();
@@ -442,12 +463,12 @@ fn warm_start(agent: &mut Agent, dir: &Path) -> Result<(), TrainError> {
 }
 
 /// Loads a checkpoint's networks and normalisers into `agent` once `check` has vetted its
-/// saved state; returns the epochs it records.
+/// saved state; returns the epochs it records and the run it was warm-started from.
 fn load_checkpoint(
     agent: &mut Agent,
     checkpoint_dir: &Path,
     check: impl Fn(&TrainState, &Agent) -> Result<(), TrainError>,
-) -> Result<Vec<EpochMetrics>, TrainError> {
+) -> Result<(Vec<EpochMetrics>, Option<PathBuf>), TrainError> {
     let state: TrainState = checkpoint::load_json(&checkpoint_dir.join("state.json"))?;
     check(&state, agent)?;
     let mut networks: [Vec<crate::params::NamedTensor>; 4] = Default::default();
@@ -462,5 +483,5 @@ fn load_checkpoint(
     })?;
     agent.observation_norm = state.observation_norm;
     agent.goal_norm = state.goal_norm;
-    Ok(state.metrics)
+    Ok((state.metrics, state.init_from))
 }

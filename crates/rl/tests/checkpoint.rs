@@ -115,7 +115,7 @@ fn a_warm_start_carries_the_networks_into_a_new_run() {
         batches_per_cycle: 0,
         ..config()
     };
-    let run = train(PointMassEnv::default, frozen, &warm).unwrap();
+    let run = train(PointMassEnv::default, frozen.clone(), &warm).unwrap();
     assert_eq!(run.metrics.len(), 1, "a new run counts its own epochs");
     let by_name = |mut tensors: Vec<dexcube_rl::params::NamedTensor>| {
         tensors.sort_by(|a, b| a.name.cmp(&b.name));
@@ -133,6 +133,16 @@ fn a_warm_start_carries_the_networks_into_a_new_run() {
         source.display().to_string(),
         "the card names where it started"
     );
+    // Resumed, the run still says where it started.
+    let resumed = TrainOptions {
+        resume: true,
+        ..options(&dir, 2, false)
+    };
+    train(PointMassEnv::default, frozen, &resumed).unwrap();
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap()).unwrap();
+    assert_eq!(card["metadata"]["epochs"], 2);
+    assert_eq!(card["metadata"]["init_from"], source.display().to_string());
     let other = DdpgHerConfig {
         hidden: vec![16],
         ..config()
