@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Args, Subcommand, ValueEnum};
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotMode};
+use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerObject, LayerOpEnv, RotMode};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -36,6 +36,10 @@ pub struct EnvChoice {
     /// LayerOpEnv's move: U U' R R' F F'.
     #[arg(long = "move", default_value = "U'")]
     pub layer_move: LayerMove,
+    /// LayerOpEnv's object: cube (the physical 2x2x2 the operator turns) or block (a
+    /// two-layer block on one hinge, quicker to simulate).
+    #[arg(long, default_value = "cube")]
+    pub object: LayerObject,
 }
 
 impl EnvChoice {
@@ -43,14 +47,22 @@ impl EnvChoice {
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
         Ok(match self.env {
             EnvKind::Rot => Box::new(CubeRotEnv::new(self.mode)?),
-            EnvKind::Layer => Box::new(LayerOpEnv::new(self.layer_move, LayerGoals::Training)?),
+            EnvKind::Layer => Box::new(LayerOpEnv::new(
+                self.object,
+                self.layer_move,
+                LayerGoals::Training,
+            )?),
         })
     }
 
     pub fn name(&self) -> String {
         match self.env {
             EnvKind::Rot => format!("CubeRotEnv ({} mode)", self.mode.name()),
-            EnvKind::Layer => format!("LayerOpEnv ({})", self.layer_move.name()),
+            // Block runs keep the label they had before the cube was an option, so they resume.
+            EnvKind::Layer => match self.object {
+                LayerObject::Block => format!("LayerOpEnv ({})", self.layer_move.name()),
+                LayerObject::Cube => format!("LayerOpEnv ({}, cube)", self.layer_move.name()),
+            },
         }
     }
 }

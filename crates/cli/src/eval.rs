@@ -11,7 +11,9 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, Info, LayerGoal, LayerMove, LayerOpEnv, RotGoal, RotMode};
+use dexcube_env::{
+    CubeRotEnv, GoalEnv, Info, LayerGoal, LayerMove, LayerObject, LayerOpEnv, RotGoal, RotMode,
+};
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
@@ -323,6 +325,9 @@ pub struct EvalStageArgs {
     threads: usize,
     #[command(flatten)]
     policies: PolicyArgs,
+    /// Stage 2's object: cube or block (default: the one the policy was trained on).
+    #[arg(long)]
+    object: Option<LayerObject>,
     /// Also write the result into the policy's JSON card, as its evaluation.
     #[arg(long)]
     record: bool,
@@ -398,10 +403,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         StageKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
         StageKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
     };
+    let object = match args.object {
+        Some(object) => object,
+        None => trained_on(&files.layer)?,
+    };
     let bar = ProgressBar::new(args.episodes as u64);
     let scene = Scene::load(match args.stage {
         StageKind::Rot => SceneKind::Rot,
-        StageKind::Layer => SceneKind::Layer,
+        StageKind::Layer => object.scene(),
     })?;
     in_parallel(
         args.threads,
@@ -432,7 +441,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let rate = wins as f64 / args.episodes as f64;
     let what = match args.stage {
         StageKind::Rot => format!("Stage 1 (CubeRotEnv, {} mode)", files.rot_mode.name()),
-        StageKind::Layer => "Stage 2 (LayerOpEnv U', goal +90°)".to_string(),
+        StageKind::Layer => format!(
+            "Stage 2 (LayerOpEnv U' on the {}, goal +90°)",
+            object.name()
+        ),
     };
     println!(
         "{what}: {wins}/{} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), seed {}, policy {}",
@@ -447,14 +459,28 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         }
     }
     if args.record {
-        record(&prefix, &args, wins, (lo, hi))?;
+        record(&prefix, &args, object, wins, (lo, hi))?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The object a Stage 2 policy was trained on, from its card (cards from before the cube was
+/// an option were all trained on the block).
+fn trained_on(layer_policy: &Path) -> anyhow::Result<LayerObject> {
+    let path = layer_policy.with_extension("json");
+    let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
+        .with_context(|| format!("reading {}", path.display()))?;
+    card["metadata"]["environment"]["object"]
+        .as_str()
+        .unwrap_or("block")
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 fn record(
     prefix: &Path,
     args: &EvalStageArgs,
+    object: LayerObject,
     successes: usize,
     (lo, hi): (f64, f64),
 ) -> anyhow::Result<()> {
@@ -467,7 +493,10 @@ fn record(
         "success_rate": successes as f64 / args.episodes as f64,
         "ci95": [lo, hi],
         "seed": args.seed,
-        "command": format!("dexcube eval-stage {} --episodes {} --seed {}", match args.stage { StageKind::Rot => "rot", StageKind::Layer => "layer" }, args.episodes, args.seed),
+        "command": match args.stage {
+            StageKind::Rot => format!("dexcube eval-stage rot --episodes {} --seed {}", args.episodes, args.seed),
+            StageKind::Layer => format!("dexcube eval-stage layer --object {} --episodes {} --seed {}", object.name(), args.episodes, args.seed),
+        },
     });
     write_atomically(&path, serde_json::to_string_pretty(&card)?.as_bytes())?;
     Ok(())

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, LayerOpEnv, RotGoal};
+use dexcube_env::{CubeRotEnv, LayerObject, LayerOpEnv, RotGoal};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
 use dexcube_sim::{Scene, SceneKind};
 
@@ -80,7 +80,11 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         EnvKind::Layer => (
             "layer",
             args.choice.layer_move.name().replace('\'', "p")
-                + if args.quarter_goals { "-quarter" } else { "" },
+                + if args.quarter_goals { "-quarter" } else { "" }
+                + match args.choice.object {
+                    LayerObject::Cube => "-cube",
+                    LayerObject::Block => "",
+                },
         ),
     };
     let (out, resume) = match (&args.out, &args.resume) {
@@ -111,6 +115,10 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "env": name,
             "variant": variant,
             "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
+            "object": match args.choice.env {
+                EnvKind::Layer => Some(args.choice.object.name()),
+                EnvKind::Rot => None,
+            },
         }),
     };
     eprintln!(
@@ -130,7 +138,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             )?
         }
         EnvKind::Layer => {
-            let scene = Scene::load(SceneKind::Layer)?;
+            let scene = Scene::load(args.choice.object.scene())?;
             let layer_move = args.choice.layer_move;
             let goals = if args.quarter_goals {
                 LayerGoals::Evaluation

@@ -1,27 +1,41 @@
-//! LayerOpEnv (Stage 2): turn one layer of a two-layer block by a quarter turn.
+//! LayerOpEnv (Stage 2): turn one layer of a cube on the palm by a quarter turn.
 //!
-//! Observation (62): the 61 of CubeRotEnv for the block (its bottom layer's pose) plus the
-//! layer angle. Goal (1): the target angle between the layers, radians, counter-clockwise
-//! seen from outside the turning layer (so U is -π/2, U' is +π/2).
+//! The layer belongs to one of two objects ([`LayerObject`]): the physical 2x2x2 cube of the
+//! `cube` scene (eight cubelets on ball joints, held in line by a detent), which is what the
+//! operator turns, or a two-layer block on one hinge (the `layer` scene), twice as quick to
+//! simulate.
+//!
+//! Observation (62): hand joint angles 24 and velocities 24, the object's position 3,
+//! orientation 4, velocity 3 and angular velocity 3 (in its own frame), then the layer angle.
+//! On the block the orientation is its bottom layer's; on the cube it is the orientation of
+//! the layer that stays (the one behind the turning face), taken among the cube's 24
+//! symmetric frames as the one nearest the move's base orientation: a 2x2x2 looks the same
+//! from every side, so the policy need not know which cubelet is which. The operator feeds
+//! its Stage 2 policy the same view ([`CubeLayer`]). Goal (1): the target angle between the
+//! layers, radians, counter-clockwise seen from outside the turning layer (so U is -π/2, U'
+//! is +π/2); on the cube it is counted from the episode's start, unwrapped.
 //!
 //! Six variants, as in the paper: the turning layer faces up (U), right (+x, R) or front
 //! (-y, F), and turns clockwise (U, R, F) or counter-clockwise (U', R', F'). What is sampled,
-//! exactly: at reset the block is placed with its turning layer facing the variant's
-//! direction, at a uniformly random angle about that direction, at the resting point plus
-//! N(0, 5 mm) noise, with its layers aligned, and left to settle. For training the goal angle
-//! is uniform in [0, π/2] (counter-clockwise) or [-π/2, 0] (clockwise), as the authors did,
-//! so HER sees intermediate goals; for evaluation it is exactly ±π/2.
+//! exactly: at reset the object is placed with its turning layer facing the variant's
+//! direction (on the cube, any of its six faces, chosen uniformly), at a uniformly random
+//! angle about that direction, at the resting point plus N(0, 5 mm) noise, with its layers
+//! aligned, and left to settle. For training the goal angle is uniform in [0, π/2]
+//! (counter-clockwise) or [-π/2, 0] (clockwise), as the authors did, so HER sees
+//! intermediate goals; for evaluation it is exactly ±π/2.
 
 use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
 
+use dexcube_cube::Face;
+use dexcube_sim::cube::{CubeState, face_normal, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
-use dexcube_sim::scene::ObjectJoints;
-use dexcube_sim::{Scene, SceneKind, SimError};
+use dexcube_sim::scene::{JointAddress, ObjectJoints};
+use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, LayerGoal, wrap_angle};
-use crate::hand_object::HandObject;
+use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// Which layer faces where, and which way it turns.
@@ -64,7 +78,7 @@ impl LayerMove {
     }
 
     /// A block orientation that points its hinge axis (block z) along `facing`.
-    fn base_orientation(self) -> Quat {
+    pub fn base_orientation(self) -> Quat {
         let h = FRAC_PI_2;
         match self {
             LayerMove::U | LayerMove::UPrime => rotation::IDENTITY,
@@ -92,37 +106,160 @@ pub enum LayerGoals {
     Evaluation,
 }
 
+/// What the turning layer belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LayerObject {
+    /// The physical 2x2x2 cube (`cube` scene): what the operator turns.
+    Cube,
+    /// A two-layer block on one hinge (`layer` scene): quicker to simulate.
+    Block,
+}
+
+impl LayerObject {
+    pub fn name(self) -> &'static str {
+        match self {
+            LayerObject::Cube => "cube",
+            LayerObject::Block => "block",
+        }
+    }
+
+    pub fn scene(self) -> SceneKind {
+        match self {
+            LayerObject::Cube => SceneKind::Cube,
+            LayerObject::Block => SceneKind::Layer,
+        }
+    }
+}
+
+impl std::str::FromStr for LayerObject {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        [LayerObject::Cube, LayerObject::Block]
+            .into_iter()
+            .find(|o| o.name() == s)
+            .ok_or_else(|| format!("unknown layer object '{s}': use cube or block"))
+    }
+}
+
+/// Stage 2's view of the physical cube, shared by LayerOpEnv and the operator: the layer
+/// that faces `facing` at the start turns against the layer behind it. Keeps the turned
+/// angle unwrapped across readings (the cube's own reading wraps at ±45°).
+#[derive(Clone, Debug)]
+pub struct CubeLayer {
+    base: Quat,
+    face: Face,
+    last: f64,
+    turned: f64,
+}
+
+impl CubeLayer {
+    /// Starts counting from the cube as it is, with the layer facing `facing` (world) as the
+    /// one that turns; `base` is the orientation the observed frame is kept nearest to.
+    /// `None` if the simulation is not of the `cube` scene.
+    pub fn start(sim: &Sim, facing: [f64; 3], base: Quat) -> Option<CubeLayer> {
+        let state = CubeState::read(sim)?;
+        let face = face_toward(&state.pose().orientation, facing);
+        Some(CubeLayer {
+            base,
+            face,
+            last: state.layer_angle(face),
+            turned: 0.0,
+        })
+    }
+
+    /// The 62 observations (the layer angle turned so far last).
+    pub fn observe(&mut self, sim: &Sim) -> Vec<f64> {
+        let Some(state) = CubeState::read(sim) else {
+            unreachable!("a CubeLayer is only started on a cube scene")
+        };
+        let now = state.layer_angle(self.face);
+        // Readings wrap at ±45°: accumulate the change, brought into ±45°.
+        let change = now - self.last;
+        self.turned += change - FRAC_PI_2 * (change / FRAC_PI_2).round();
+        self.last = now;
+        let (frame, spin) = state.layer_behind(self.face);
+        let (symmetry, _) = rotation::snap_to_cube(
+            &rotation::mul(&rotation::conj(&frame), &self.base),
+            rotation::cube_group(),
+        );
+        let seen = canonical(rotation::normalise(&rotation::mul(&frame, &symmetry)));
+        let (velocity, _) = sim.object_velocity();
+        let mut out = Vec::with_capacity(BASE_OBSERVATION + 1);
+        out.extend(sim.hand_angles());
+        out.extend(sim.hand_velocities());
+        out.extend(state.pose().position);
+        out.extend(seen);
+        out.extend(velocity);
+        out.extend(rotation::rotate(&rotation::conj(&seen), spin));
+        out.push(self.turned);
+        out
+    }
+
+    /// Accounts for a turn by `change` made outside the physics (a kinematic turn may jump
+    /// past the ±45° within which readings are unwrapped).
+    fn turned_by(&mut self, sim: &Sim, change: f64) {
+        if let Some(state) = CubeState::read(sim) {
+            self.last = state.layer_angle(self.face);
+            self.turned += change;
+        }
+    }
+
+    /// The angle turned since the start, as of the last observation.
+    pub fn turned(&self) -> f64 {
+        self.turned
+    }
+}
+
+/// The layer of the object and how it is read.
+enum Layer {
+    Block { hinge: JointAddress },
+    Cube(CubeLayer),
+}
+
 pub struct LayerOpEnv {
     hand: HandObject,
     layer_move: LayerMove,
     goals: LayerGoals,
     goal: Arc<LayerGoal>,
     desired: f64,
-    hinge: dexcube_sim::scene::JointAddress,
+    layer: Layer,
 }
 
 impl LayerOpEnv {
-    pub fn new(layer_move: LayerMove, goals: LayerGoals) -> Result<LayerOpEnv, SimError> {
+    pub fn new(
+        object: LayerObject,
+        layer_move: LayerMove,
+        goals: LayerGoals,
+    ) -> Result<LayerOpEnv, SimError> {
         Ok(LayerOpEnv::with_scene(
-            Scene::load(SceneKind::Layer)?,
+            Scene::load(object.scene())?,
             layer_move,
             goals,
         ))
     }
 
-    /// A LayerOpEnv over an already loaded `layer` scene. Panics if the scene is not one.
+    /// A LayerOpEnv over an already loaded `cube` or `layer` scene. Panics on another scene.
     pub fn with_scene(scene: Arc<Scene>, layer_move: LayerMove, goals: LayerGoals) -> LayerOpEnv {
-        let ObjectJoints::Layer { hinge, .. } = *scene.object() else {
-            panic!("LayerOpEnv needs the layer scene, not {}", scene.kind());
+        let hand = HandObject::new(scene.clone());
+        let layer = match *scene.object() {
+            ObjectJoints::Layer { hinge, .. } => Layer::Block { hinge },
+            ObjectJoints::Cube { .. } => Layer::Cube(
+                CubeLayer::start(
+                    &hand.sim,
+                    layer_move.facing(),
+                    layer_move.base_orientation(),
+                )
+                .expect("a cube scene"),
+            ),
+            ObjectJoints::Rot { .. } => panic!("LayerOpEnv needs the cube or layer scene"),
         };
-        let hand = HandObject::new(scene);
         LayerOpEnv {
             hand,
             layer_move,
             goals,
             goal: Arc::new(LayerGoal::default()),
             desired: layer_move.direction() * FRAC_PI_2,
-            hinge,
+            layer,
         }
     }
 
@@ -130,46 +267,71 @@ impl LayerOpEnv {
         self.layer_move
     }
 
-    /// The angle between the layers, in (-π, π].
-    pub fn layer_angle(&self) -> f64 {
-        layer_angle(&self.hand, self.hinge)
+    pub fn object(&self) -> LayerObject {
+        match self.layer {
+            Layer::Block { .. } => LayerObject::Block,
+            Layer::Cube(_) => LayerObject::Cube,
+        }
     }
 
-    /// Sets the layer angle kinematically (for tests and demonstrations).
+    /// The angle between the layers: on the block in (-π, π], on the cube as turned since
+    /// the episode's start.
+    pub fn layer_angle(&self) -> f64 {
+        match &self.layer {
+            Layer::Block { hinge } => block_angle(&self.hand, *hinge),
+            Layer::Cube(tracker) => tracker.turned(),
+        }
+    }
+
+    /// Turns the layer kinematically to `angle` (for tests and demonstrations).
     pub fn set_layer_angle(&mut self, angle: f64) {
-        let data = self.hand.sim.data_mut();
-        data.qpos_mut()[self.hinge.qpos] = angle;
-        data.qvel_mut()[self.hinge.dof] = 0.0;
+        let change = angle - self.layer_angle();
+        match &mut self.layer {
+            Layer::Block { hinge } => {
+                let data = self.hand.sim.data_mut();
+                data.qpos_mut()[hinge.qpos] = angle;
+                data.qvel_mut()[hinge.dof] = 0.0;
+            }
+            Layer::Cube(tracker) => {
+                let facing = self.layer_move.facing();
+                let world_face = Face::ALL
+                    .into_iter()
+                    .find(|&f| face_normal(f) == facing)
+                    .expect("moves face along an axis");
+                turn_face_by(&mut self.hand.sim, world_face, change);
+                self.hand.sim.forward();
+                tracker.turned_by(&self.hand.sim, change);
+            }
+        }
         self.hand.sim.forward();
     }
 
     pub fn set_desired_goal(&mut self, angle: f64) {
         self.desired = angle;
     }
+}
 
-    fn observe(&self) -> Observation {
-        observe(&self.hand, self.hinge, self.desired)
+impl Layer {
+    /// The 62 observations and the layer angle, which is also the achieved goal.
+    fn observe(&mut self, hand: &HandObject, desired: f64) -> Observation {
+        let observation = match self {
+            Layer::Block { hinge } => {
+                let mut observation = hand.base_observation();
+                observation.push(block_angle(hand, *hinge));
+                observation
+            }
+            Layer::Cube(tracker) => tracker.observe(&hand.sim),
+        };
+        Observation {
+            achieved_goal: vec![observation[BASE_OBSERVATION]],
+            desired_goal: vec![desired],
+            observation,
+        }
     }
 }
 
-fn layer_angle(hand: &HandObject, hinge: dexcube_sim::scene::JointAddress) -> f64 {
+fn block_angle(hand: &HandObject, hinge: JointAddress) -> f64 {
     wrap_angle(hand.sim.data().qpos()[hinge.qpos])
-}
-
-/// The 61 observations and the layer angle, which is also the achieved goal.
-fn observe(
-    hand: &HandObject,
-    hinge: dexcube_sim::scene::JointAddress,
-    desired: f64,
-) -> Observation {
-    let mut observation = hand.base_observation();
-    let angle = layer_angle(hand, hinge);
-    observation.push(angle);
-    Observation {
-        observation,
-        achieved_goal: vec![angle],
-        desired_goal: vec![desired],
-    }
 }
 
 impl SimulatedEnv for LayerOpEnv {
@@ -185,7 +347,7 @@ impl SimulatedEnv for LayerOpEnv {
 impl GoalEnv for LayerOpEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
-            observation: 62,
+            observation: BASE_OBSERVATION + 1,
             goal: 1,
             action: dexcube_sim::HAND_ACTUATORS,
         }
@@ -198,27 +360,36 @@ impl GoalEnv for LayerOpEnv {
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
         self.hand.seed(seed);
         let (facing, base) = (self.layer_move.facing(), self.layer_move.base_orientation());
+        // On the cube any face may be the turning one: its cubelets are alike.
+        let faces = match self.layer {
+            Layer::Block { .. } => vec![rotation::IDENTITY],
+            Layer::Cube(_) => rotation::cube_group().to_vec(),
+        };
         self.hand.place(|rng| {
             let spin = rotation::about(
                 facing,
                 rng.random_range(-std::f64::consts::PI..std::f64::consts::PI),
             );
-            rotation::normalise(&rotation::mul(&spin, &base))
+            let face = faces[rng.random_range(0..faces.len())];
+            rotation::normalise(&rotation::mul(&rotation::mul(&spin, &base), &face))
         });
+        if let Layer::Cube(tracker) = &mut self.layer {
+            *tracker = CubeLayer::start(&self.hand.sim, facing, base).expect("a cube scene");
+        }
         let size = match self.goals {
             LayerGoals::Training => self.hand.rng.random_range(0.0..=FRAC_PI_2),
             LayerGoals::Evaluation => FRAC_PI_2,
         };
         self.desired = self.layer_move.direction() * size;
-        let observation = self.observe();
+        let observation = self.layer.observe(&self.hand, self.desired);
         let info = self.hand.info(&observation, self.goal.as_ref(), None);
         (observation, info)
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {
-        let (hinge, desired) = (self.hinge, self.desired);
+        let (layer, desired) = (&mut self.layer, self.desired);
         self.hand.step(action, self.goal.as_ref(), |hand| {
-            observe(hand, hinge, desired)
+            layer.observe(hand, desired)
         })
     }
 }

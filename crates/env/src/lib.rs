@@ -6,7 +6,8 @@
 //! Replay can relabel), and `terminated` / `truncated` as in Gymnasium.
 //!
 //! - [`CubeRotEnv`] (Stage 1): re-pose a rigid 5 cm cube on the palm; observation 61, goal 7.
-//! - [`LayerOpEnv`] (Stage 2): turn one layer of a two-layer block; observation 62, goal 1.
+//! - [`LayerOpEnv`] (Stage 2): turn one layer of the physical 2x2x2 cube (or of a two-layer
+//!   block); observation 62, goal 1.
 //! - [`VecEnv`]: many environments stepped on a thread pool, each with its own `MjData`.
 //!
 //! Dynamics follow Gymnasium-Robotics' hand environments: an action in [-1, 1]^20 maps onto
@@ -25,7 +26,7 @@ use std::sync::Arc;
 pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{DROP_DEPTH, base_observation, is_dropped, resting_point};
-pub use layer::{LayerMove, LayerOpEnv};
+pub use layer::{CubeLayer, LayerMove, LayerObject, LayerOpEnv};
 pub use rot::{CubeRotEnv, pose_goal};
 pub use vec_env::VecEnv;
 

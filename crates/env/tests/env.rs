@@ -1,8 +1,15 @@
 //! The goal-env contract of CubeRotEnv and LayerOpEnv, with real physics.
 
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, RotMode, SimulatedEnv, VecEnv};
+use dexcube_env::{
+    CubeLayer, CubeRotEnv, GoalEnv, LayerMove, LayerObject, LayerOpEnv, RotMode, SimulatedEnv,
+    VecEnv,
+};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+
+use dexcube_cube::Face;
 use dexcube_sim::Pose;
+use dexcube_sim::cube::turn_face_by;
 use dexcube_sim::rotation::{self, about};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -22,7 +29,8 @@ fn spaces_have_the_papers_sizes() {
         ),
         (61, 7, 20)
     );
-    let mut layer = LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Training).unwrap();
+    let mut layer =
+        LayerOpEnv::new(LayerObject::Block, LayerMove::UPrime, LayerGoals::Training).unwrap();
     assert_eq!((layer.spaces().observation, layer.spaces().goal), (62, 1));
     let (obs, _) = layer.reset(Some(1));
     assert_eq!(
@@ -71,8 +79,12 @@ fn rewards_agree(env: &mut dyn GoalEnv, episodes: u64) -> usize {
 #[test]
 fn compute_reward_agrees_with_step_on_thousands_of_transitions() {
     let mut rot = CubeRotEnv::new(RotMode::Paper).unwrap();
-    let mut layer = LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Training).unwrap();
-    let checked = rewards_agree(&mut rot, 12) + rewards_agree(&mut layer, 12);
+    let mut block =
+        LayerOpEnv::new(LayerObject::Block, LayerMove::UPrime, LayerGoals::Training).unwrap();
+    let mut cube =
+        LayerOpEnv::new(LayerObject::Cube, LayerMove::UPrime, LayerGoals::Training).unwrap();
+    let checked =
+        rewards_agree(&mut rot, 12) + rewards_agree(&mut block, 12) + rewards_agree(&mut cube, 6);
     assert!(checked > 1000, "{checked}");
 }
 
@@ -138,30 +150,83 @@ fn rot_success_is_detected_just_inside_and_not_just_outside_the_thresholds() {
 
 #[test]
 fn layer_success_is_detected_within_a_tenth_of_a_radian() {
-    let mut env = LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
-    let (obs, _) = env.reset(Some(5));
-    assert_eq!(obs.desired_goal, [std::f64::consts::FRAC_PI_2]);
-    for (offset, success) in [
-        (0.0, true),
-        (0.09, true),
-        (-0.09, true),
-        (0.11, false),
-        (-0.11, false),
-    ] {
-        env.set_layer_angle(std::f64::consts::FRAC_PI_2 + offset);
-        let t = env.step(&[0.0; 20]);
-        let (a, d) = (&t.observation.achieved_goal, &t.observation.desired_goal);
-        // One step of physics moves the layer a little: judge what was achieved.
-        assert_eq!(env.goal().is_success(a, d), (a[0] - d[0]).abs() < 0.1);
-        let exact = env
-            .goal()
-            .is_success(&[std::f64::consts::FRAC_PI_2 + offset], d);
-        assert_eq!(exact, success, "offset {offset}");
+    for object in [LayerObject::Block, LayerObject::Cube] {
+        let mut env = LayerOpEnv::new(object, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
+        let (obs, _) = env.reset(Some(5));
+        assert_eq!(obs.desired_goal, [FRAC_PI_2]);
+        for (offset, success) in [
+            (0.0, true),
+            (0.09, true),
+            (-0.09, true),
+            (0.11, false),
+            (-0.11, false),
+        ] {
+            env.set_layer_angle(FRAC_PI_2 + offset);
+            let t = env.step(&[0.0; 20]);
+            let (a, d) = (&t.observation.achieved_goal, &t.observation.desired_goal);
+            assert!(
+                (a[0] - (FRAC_PI_2 + offset)).abs() < 0.05,
+                "{object:?}: set {offset} past a quarter turn, read {}",
+                a[0] - FRAC_PI_2
+            );
+            // One step of physics moves the layer a little: judge what was achieved.
+            assert_eq!(env.goal().is_success(a, d), (a[0] - d[0]).abs() < 0.1);
+            let exact = env.goal().is_success(&[FRAC_PI_2 + offset], d);
+            assert_eq!(exact, success, "{object:?}: offset {offset}");
+        }
     }
     assert_eq!(
         LayerMove::U.direction(),
         -1.0,
         "U is clockwise: a negative angle"
+    );
+}
+
+/// On the physical cube any face may start on top, and the free joint's cubelet (DBL) may be
+/// in the turning layer or the one that stays. Either way Stage 2 sees the layer that stays,
+/// in the frame nearest upright, and the angle turned counts on past the ±45° where the
+/// cube's own reading wraps.
+#[test]
+fn the_cube_is_seen_through_the_layer_that_stays_whichever_face_is_up() {
+    let mut env =
+        LayerOpEnv::new(LayerObject::Cube, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
+    let orientation = |o: &[f64]| [o[51], o[52], o[53], o[54]];
+    let (mut frame_carried_by_the_turn, mut frame_kept) = (0, 0);
+    for seed in 0..12 {
+        env.reset(Some(seed));
+        let mut view = CubeLayer::start(env.sim(), [0.0, 0.0, 1.0], rotation::IDENTITY).unwrap();
+        let seen = orientation(&view.observe(env.sim()));
+        assert!(
+            rotation::angle_between(&seen, &rotation::IDENTITY) < FRAC_PI_4 + 0.3,
+            "seed {seed}: the frame is kept near upright"
+        );
+        let frame_before = env.sim().object_pose().orientation;
+        let mut turned = 0.0;
+        for angle in [0.5, 1.0, FRAC_PI_2, 2.0] {
+            turn_face_by(env.sim_mut(), Face::U, angle - turned);
+            env.sim_mut().forward();
+            turned = angle;
+            let observation = view.observe(env.sim());
+            assert!(
+                (observation[61] - angle).abs() < 1e-6,
+                "seed {seed}: turned to {angle}, read {}",
+                observation[61]
+            );
+            let now = orientation(&observation);
+            assert!(
+                rotation::angle_between(&now, &seen) < 1e-6,
+                "seed {seed}: the layer that stays is seen to stay: {seen:?}, then {now:?} at {angle}"
+            );
+        }
+        if rotation::angle_between(&env.sim().object_pose().orientation, &frame_before) > 1.0 {
+            frame_carried_by_the_turn += 1;
+        } else {
+            frame_kept += 1;
+        }
+    }
+    assert!(
+        frame_carried_by_the_turn > 0 && frame_kept > 0,
+        "both cases drawn: {frame_carried_by_the_turn} carried, {frame_kept} kept"
     );
 }
 
@@ -214,7 +279,9 @@ fn a_dropped_cube_ends_the_episode_as_a_failure() {
 #[test]
 fn a_blown_up_simulation_resets_that_env_only() {
     let envs = (0..2)
-        .map(|_| LayerOpEnv::new(LayerMove::UPrime, LayerGoals::Training).unwrap())
+        .map(|_| {
+            LayerOpEnv::new(LayerObject::Block, LayerMove::UPrime, LayerGoals::Training).unwrap()
+        })
         .collect();
     let mut vec_env = VecEnv::new(envs, 2);
     vec_env.reset(7);

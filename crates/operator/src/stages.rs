@@ -8,10 +8,11 @@ use std::f64::consts::FRAC_PI_2;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, base_observation, is_dropped, pose_goal,
+    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, base_observation, is_dropped,
+    pose_goal,
 };
 use dexcube_rl::Policy;
-use dexcube_sim::cube::{CubeState, face_normal, turn_face_by};
+use dexcube_sim::cube::{face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{HAND_ACTUATORS, Pose, Sim};
 use rand_chacha::ChaCha8Rng;
@@ -105,8 +106,8 @@ impl Stage1 for PolicyStage1 {
     }
 }
 
-/// Stage 2 by a LayerOpEnv U' policy. The layer angle is measured from the stage's start,
-/// unwrapped, about the face that is up.
+/// Stage 2 by a LayerOpEnv U' policy, which sees the cube as LayerOpEnv does on the `cube`
+/// scene ([`CubeLayer`]): the layer that stays, and the angle turned since the stage began.
 pub struct PolicyStage2 {
     pub policy: Policy,
     pub resting_z: f64,
@@ -114,41 +115,27 @@ pub struct PolicyStage2 {
 
 /// The cube-frame face whose outward normal points most nearly up in the world.
 pub fn face_up(sim: &Sim) -> Face {
-    let q = sim.object_pose().orientation;
-    Face::ALL
-        .into_iter()
-        .max_by(|&a, &b| {
-            rotation::rotate(&q, face_normal(a))[2]
-                .total_cmp(&rotation::rotate(&q, face_normal(b))[2])
-        })
-        .unwrap_or(Face::U)
+    face_toward(&sim.object_pose().orientation, UP)
 }
+
+const UP: [f64; 3] = [0.0, 0.0, 1.0];
 
 impl Stage2 for PolicyStage2 {
     fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let up = face_up(sim);
-        let read = |sim: &Sim| CubeState::read(sim).map_or(0.0, |s| s.layer_angle(up));
-        let (mut last, mut total) = (read(sim), 0.0);
+        let Some(mut view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
+            return StageRun::default();
+        };
         let goal = [FRAC_PI_2];
         let policy = &self.policy;
-        let mut angle = move |sim: &Sim| {
-            let now = read(sim);
-            // Quarter-turn readings wrap at ±45°: accumulate the change, brought into ±45°.
-            let change = now - last;
-            total += change - FRAC_PI_2 * (change / FRAC_PI_2).round();
-            last = now;
-            total
-        };
-        let latest = std::cell::Cell::new(0.0);
+        let turned = std::cell::Cell::new(0.0);
         drive(
             sim,
             |sim| {
-                latest.set(angle(sim));
-                let mut observation = base_observation(sim);
-                observation.push(latest.get());
+                let observation = view.observe(sim);
+                turned.set(view.turned());
                 policy.act(&observation, &goal)
             },
-            |_| LayerGoal::default().is_success(&[latest.get()], &goal),
+            |_| LayerGoal::default().is_success(&[turned.get()], &goal),
             self.resting_z,
             watch,
         )

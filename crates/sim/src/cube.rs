@@ -7,7 +7,6 @@
 //! left over after snapping is the misalignment that the "good state" check bounds.
 
 use std::f64::consts::FRAC_PI_2;
-use std::sync::OnceLock;
 
 use dexcube_cube::facelet::{CORNER_COLOURS, CORNER_FACELETS, CORNER_NAMES, DBL};
 use dexcube_cube::{Face, FaceletError, Facelets, Move};
@@ -37,6 +36,8 @@ pub struct CubeState {
     pose: Pose,
     /// Each cubelet's rotation within the cube frame, by home slot (DBL's is the identity).
     rotations: [Quat; 8],
+    /// Each cubelet's angular velocity in the cube frame, rad/s, by home slot.
+    spins: [[f64; 3]; 8],
 }
 
 impl CubeState {
@@ -44,12 +45,19 @@ impl CubeState {
     pub fn read(sim: &Sim) -> Option<CubeState> {
         let balls = sim.scene().object().cube_balls()?;
         let mut rotations = [IDENTITY; 8];
+        // DBL's own angular velocity (its free joint's, in its frame, which is the cube's);
+        // a ball joint's velocity is relative to DBL and in the cubelet's own frame.
+        let (_, frame_spin) = sim.object_velocity();
+        let mut spins = [frame_spin; 8];
         for (slot, ball) in balls.into_iter().enumerate() {
             rotations[slot] = rotation::normalise(&sim.ball(ball));
+            let relative = rotation::rotate(&rotations[slot], sim.ball_velocity(ball));
+            spins[slot] = std::array::from_fn(|k| frame_spin[k] + relative[k]);
         }
         Some(CubeState {
             pose: sim.object_pose(),
             rotations,
+            spins,
         })
     }
 
@@ -68,7 +76,7 @@ impl CubeState {
     pub fn misalignment(&self) -> f64 {
         self.rotations
             .iter()
-            .map(|q| rotation::snap_to_cube(q, group()).1)
+            .map(|q| rotation::snap_to_cube(q, rotation::cube_group()).1)
             .fold(0.0, f64::max)
     }
 
@@ -83,16 +91,53 @@ impl CubeState {
         let axis = face_normal(face);
         let (mut near, mut far) = (Vec::new(), Vec::new());
         for (home, q) in self.rotations.iter().enumerate() {
-            let (snapped, _) = rotation::snap_to_cube(q, group());
+            let (snapped, _) = rotation::snap_to_cube(q, rotation::cube_group());
             let residual = rotation::mul(q, &rotation::conj(&snapped));
             let twist = rotation::twist_about(&residual, axis);
-            if dot(rotation::rotate(&snapped, slot_centre(home)), axis) > 0.0 {
+            if in_layer(&snapped, home, axis) {
                 near.push(twist);
             } else {
                 far.push(twist);
             }
         }
         mean(&near) - mean(&far)
+    }
+
+    /// How the layer opposite `face` (the one that stays while `face` turns) moves: its
+    /// orientation in the world, as the cube frame would be if that layer were home, and its
+    /// angular velocity in the world frame. Both are means over its four cubelets.
+    pub fn layer_behind(&self, face: Face) -> (Quat, [f64; 3]) {
+        let axis = face_normal(face);
+        let (mut sum, mut spin, mut n) = ([0.0; 4], [0.0; 3], 0.0);
+        for (home, q) in self.rotations.iter().enumerate() {
+            let (snapped, _) = rotation::snap_to_cube(q, rotation::cube_group());
+            if in_layer(&snapped, home, axis) {
+                continue;
+            }
+            // The cube frame carried by this cubelet: its rotation with its slot taken away.
+            // Near 45° cubelets may snap to neighbouring slots, which turns what they carry
+            // by a cube rotation; bring each to the first one's before averaging.
+            let mut carried = rotation::mul(q, &rotation::conj(&snapped));
+            if n > 0.0 {
+                let (g, _) = rotation::snap_to_cube(
+                    &rotation::mul(&rotation::conj(&carried), &sum),
+                    rotation::cube_group(),
+                );
+                carried = rotation::mul(&carried, &g);
+            }
+            let reference = if n > 0.0 { sum } else { IDENTITY };
+            let sign = carried.iter().zip(&reference).map(|(a, b)| a * b).sum::<f64>().signum();
+            for (total, c) in sum.iter_mut().zip(carried) {
+                *total += sign * c;
+            }
+            for (total, w) in spin.iter_mut().zip(self.spins[home]) {
+                *total += w;
+            }
+            n += 1.0;
+        }
+        let orientation = rotation::mul(&self.pose.orientation, &rotation::normalise(&sum));
+        let spin = rotation::rotate(&self.pose.orientation, spin.map(|w| w / n));
+        (rotation::normalise(&orientation), spin)
     }
 
     /// The 24 stickers seen in the cube's own frame: DBL is always home, so this is the
@@ -104,14 +149,14 @@ impl CubeState {
     /// The 24 stickers by the world direction they face (U up, R towards +x, B towards +y),
     /// with the cube's orientation snapped to the nearest axis-aligned one.
     pub fn facelets_in_world(&self) -> Result<Facelets, FaceletError> {
-        let (frame, _) = rotation::snap_to_cube(&self.pose.orientation, group());
+        let (frame, _) = rotation::snap_to_cube(&self.pose.orientation, rotation::cube_group());
         self.facelets_seen_from(&frame)
     }
 
     fn facelets_seen_from(&self, frame: &Quat) -> Result<Facelets, FaceletError> {
         let mut stickers = ['?'; 24];
         for (home, q) in self.rotations.iter().enumerate() {
-            let (snapped, _) = rotation::snap_to_cube(q, group());
+            let (snapped, _) = rotation::snap_to_cube(q, rotation::cube_group());
             let g = rotation::mul(frame, &snapped);
             let slot = slot_at(rotation::rotate(&g, slot_centre(home)));
             for k in 0..3 {
@@ -147,7 +192,7 @@ pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
         return false;
     };
     // The same face in the cube's own frame.
-    let (frame, _) = rotation::snap_to_cube(&state.pose.orientation, group());
+    let (frame, _) = rotation::snap_to_cube(&state.pose.orientation, rotation::cube_group());
     let face = face_at(rotation::rotate(&rotation::conj(&frame), face_normal(face)));
     let turn = rotation::about(face_normal(face), angle);
     let in_layer: Vec<bool> = state
@@ -155,11 +200,11 @@ pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
         .iter()
         .enumerate()
         .map(|(home, q)| {
-            let (snapped, _) = rotation::snap_to_cube(q, group());
-            dot(
-                rotation::rotate(&snapped, slot_centre(home)),
+            in_layer(
+                &rotation::snap_to_cube(q, rotation::cube_group()).0,
+                home,
                 face_normal(face),
-            ) > 0.0
+            )
         })
         .collect();
     if in_layer[DBL] {
@@ -192,7 +237,10 @@ pub fn snap_layers(sim: &mut Sim) -> bool {
         return false;
     };
     for ball in balls {
-        let (snapped, _) = rotation::snap_to_cube(&rotation::normalise(&sim.ball(ball)), group());
+        let (snapped, _) = rotation::snap_to_cube(
+            &rotation::normalise(&sim.ball(ball)),
+            rotation::cube_group(),
+        );
         sim.set_ball(ball, &snapped);
     }
     sim.forward();
@@ -203,7 +251,7 @@ pub fn snap_layers(sim: &mut Sim) -> bool {
 pub(crate) fn apply_detent(sim: &mut Sim, balls: &[JointAddress; 7]) {
     for &ball in balls {
         let q = rotation::normalise(&sim.ball(ball));
-        let (snapped, angle) = rotation::snap_to_cube(&q, group());
+        let (snapped, angle) = rotation::snap_to_cube(&q, rotation::cube_group());
         let torque = if !(1e-9..DETENT_CAPTURE).contains(&angle) {
             [0.0; 3]
         } else {
@@ -223,11 +271,6 @@ pub(crate) fn apply_detent(sim: &mut Sim, balls: &[JointAddress; 7]) {
         };
         sim.data_mut().qfrc_applied_mut()[ball.dof..ball.dof + 3].copy_from_slice(&torque);
     }
-}
-
-fn group() -> &'static [Quat; 24] {
-    static GROUP: OnceLock<[Quat; 24]> = OnceLock::new();
-    GROUP.get_or_init(rotation::cube_rotations)
 }
 
 /// The outward normal of a face in the cube frame (x = R, y = B, z = U).
@@ -250,11 +293,23 @@ fn slot_centre(slot: usize) -> [f64; 3] {
     })
 }
 
+/// Whether the cubelet from `home`, now at the slot `snapped` takes it to, is in the layer
+/// facing `axis` (cube frame).
+fn in_layer(snapped: &Quat, home: usize, axis: [f64; 3]) -> bool {
+    dot(rotation::rotate(snapped, slot_centre(home)), axis) > 0.0
+}
+
 /// The slot whose direction is nearest `v`.
 fn slot_at(v: [f64; 3]) -> usize {
     (0..8)
         .max_by(|&a, &b| dot(slot_centre(a), v).total_cmp(&dot(slot_centre(b), v)))
         .unwrap_or(0)
+}
+
+/// The cube-frame face that points most nearly along the world `direction`, for a cube
+/// whose frame has `orientation`.
+pub fn face_toward(orientation: &Quat, direction: [f64; 3]) -> Face {
+    face_at(rotation::rotate(&rotation::conj(orientation), direction))
 }
 
 /// The face whose normal is nearest `v`.

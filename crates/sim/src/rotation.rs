@@ -67,6 +67,12 @@ pub fn cube_rotations() -> [Quat; 24] {
     all.try_into().expect("a cube has 24 rotations")
 }
 
+/// The 24 proper rotations of a cube, computed once.
+pub fn cube_group() -> &'static [Quat; 24] {
+    static GROUP: std::sync::OnceLock<[Quat; 24]> = std::sync::OnceLock::new();
+    GROUP.get_or_init(cube_rotations)
+}
+
 /// The cube rotation nearest to `q`, and the angle between them. The nearest rotation has
 /// the largest |⟨g, q⟩|, so only that one needs an arccos; this runs in every physics substep
 /// of the physical cube, seven times.

@@ -196,6 +196,12 @@ impl Sim {
         [q[0], q[1], q[2], q[3]]
     }
 
+    /// A ball joint's angular velocity, in its child body's frame.
+    pub(crate) fn ball_velocity(&self, joint: JointAddress) -> [f64; 3] {
+        let v = &self.data.qvel()[joint.dof..joint.dof + 3];
+        [v[0], v[1], v[2]]
+    }
+
     pub(crate) fn set_ball(&mut self, joint: JointAddress, q: &Quat) {
         self.data.qpos_mut()[joint.qpos..joint.qpos + 4].copy_from_slice(q);
         self.data.qvel_mut()[joint.dof..joint.dof + 3].fill(0.0);
