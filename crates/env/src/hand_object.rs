@@ -21,8 +21,8 @@ pub const BASE_OBSERVATION: usize = 61;
 pub const DROP_DEPTH: f64 = 0.05;
 
 /// Control steps with a neutral action that let a newly placed object settle, as
-/// Gymnasium-Robotics does.
-const SETTLE_STEPS: usize = 10;
+/// Gymnasium-Robotics does. Every episode starts from the hand so settled.
+pub const SETTLE_STEPS: usize = 10;
 
 /// Standard deviation of the object's start position around its resting point, metres
 /// (Gymnasium-Robotics' 0.005).

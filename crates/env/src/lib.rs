@@ -25,7 +25,7 @@ use std::sync::Arc;
 
 pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
-pub use hand_object::{DROP_DEPTH, base_observation, is_dropped, resting_point};
+pub use hand_object::{DROP_DEPTH, SETTLE_STEPS, base_observation, is_dropped, resting_point};
 pub use layer::{CubeLayer, LayerMove, LayerObject, LayerOpEnv};
 pub use rot::{CubeRotEnv, pose_goal};
 pub use vec_env::VecEnv;

@@ -8,8 +8,8 @@ use std::f64::consts::FRAC_PI_2;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, base_observation, is_dropped,
-    pose_goal,
+    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS, base_observation,
+    is_dropped, pose_goal,
 };
 use dexcube_rl::Policy;
 use dexcube_sim::cube::{face_toward, turn_face_by};
@@ -52,7 +52,13 @@ pub struct StageRun {
     pub diverged: bool,
 }
 
-/// Runs a policy for up to an episode, stopping early when `done` says so.
+/// Runs a policy for up to an episode, stopping early when `done` says so. First the hand
+/// opens flat (the model's zero pose) and then takes the neutral action, `SETTLE_STEPS`
+/// each, with the cube on its palm: every training episode starts that way, from a hand
+/// placed flat and left to settle, while the previous stage leaves the fingers wherever it
+/// ended (the paper's "problematic end states"). Going straight to the neutral action from
+/// such an end state throws the cube off the palm. These steps count as control steps, not
+/// as an action.
 fn drive(
     sim: &mut Sim,
     mut act: impl FnMut(&Sim) -> Vec<f64>,
@@ -61,7 +67,45 @@ fn drive(
     watch: Watch,
 ) -> StageRun {
     let mut run = StageRun::default();
-    for _ in 0..EPISODE_STEPS {
+    let open = sim.scene().open_hand_action().to_vec();
+    for relax in [open, vec![0.0; HAND_ACTUATORS]] {
+        let hold = |_: &Sim| relax.clone();
+        if !advance(
+            sim,
+            hold,
+            |_| false,
+            SETTLE_STEPS,
+            resting_z,
+            watch,
+            &mut run,
+        ) {
+            return run;
+        }
+    }
+    advance(
+        sim,
+        &mut act,
+        &mut done,
+        EPISODE_STEPS,
+        resting_z,
+        watch,
+        &mut run,
+    );
+    run
+}
+
+/// Up to `steps` control steps of `act`, stopping early when `done` says so; false if the
+/// cube dropped or the physics blew up (noted in `run`).
+fn advance(
+    sim: &mut Sim,
+    mut act: impl FnMut(&Sim) -> Vec<f64>,
+    mut done: impl FnMut(&Sim) -> bool,
+    steps: usize,
+    resting_z: f64,
+    watch: Watch,
+    run: &mut StageRun,
+) -> bool {
+    for _ in 0..steps {
         if done(sim) {
             break;
         }
@@ -74,15 +118,15 @@ fn drive(
         run.steps += 1;
         if sim.step().is_err() {
             run.diverged = true;
-            break;
+            return false;
         }
         watch(sim);
         if is_dropped(sim, resting_z) {
             run.dropped = true;
-            break;
+            return false;
         }
     }
-    run
+    true
 }
 
 /// Stage 1 by a CubeRotEnv policy.

@@ -126,7 +126,12 @@ impl CubeState {
                 carried = rotation::mul(&carried, &g);
             }
             let reference = if n > 0.0 { sum } else { IDENTITY };
-            let sign = carried.iter().zip(&reference).map(|(a, b)| a * b).sum::<f64>().signum();
+            let sign = carried
+                .iter()
+                .zip(&reference)
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+                .signum();
             for (total, c) in sum.iter_mut().zip(carried) {
                 *total += sign * c;
             }

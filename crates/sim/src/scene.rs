@@ -217,6 +217,14 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// The action whose targets are the model's zero pose (the open, flat hand every
+    /// episode starts from), clamped into the actuators' ranges.
+    pub fn open_hand_action(&self) -> [f64; HAND_ACTUATORS] {
+        std::array::from_fn(|i| (-self.ctrl_centre[i] / self.ctrl_half_range[i]).clamp(-1.0, 1.0))
+    }
+}
+
 /// Name look-ups that fail with the scene's path in the message.
 struct Lookup<'a> {
     model: &'a MjModel,

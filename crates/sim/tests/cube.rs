@@ -225,3 +225,25 @@ fn only_aligned_layers_turn() {
         assert!(blocked < 0.1, "U turned {degrees}° blocks R: {blocked}");
     }
 }
+
+/// The open-hand action drives every joint back towards the model's zero pose (the flat hand
+/// that episodes start from), or to its actuator's nearest limit, from a clenched hand.
+#[test]
+fn the_open_hand_action_flattens_a_clenched_hand() {
+    let mut sim = cube_sim();
+    sim.set_action(&[1.0; dexcube_sim::HAND_ACTUATORS]);
+    settle(&mut sim, 25);
+    let clenched = sim.hand_angles();
+    sim.set_action(&sim.scene().open_hand_action());
+    settle(&mut sim, 25);
+    let open = sim.hand_angles();
+    let far = |angles: &[f64]| angles.iter().map(|a| a.abs()).fold(0.0, f64::max);
+    assert!(far(&clenched) > 1.0, "clenched: {clenched:?}");
+    assert!(
+        open.iter()
+            .zip(&clenched)
+            .all(|(o, c)| o.abs() <= c.abs() + 0.05),
+        "every joint nearer zero: {clenched:?} then {open:?}"
+    );
+    assert!(far(&open) < 0.5, "open: {open:?}");
+}
