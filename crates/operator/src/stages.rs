@@ -222,8 +222,10 @@ impl Stage2 for KinematicStage2 {
 }
 
 /// Re-seats the cube on the palm at a uniformly random orientation, keeping its layers as
-/// they are: the paper's randomisation before Stage 1 is repeated.
+/// they are: the paper's randomisation before Stage 1 is repeated. The hand is put back flat,
+/// as at the start of a training episode, so that the cube is not seated into its fingers.
 pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
+    sim.reset_hand();
     sim.set_object_pose(&Pose {
         position,
         orientation: uniform_rotation(rng),

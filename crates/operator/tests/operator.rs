@@ -5,9 +5,10 @@
 use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::RotMode;
 use dexcube_operator::stages::{
-    KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached,
+    KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached, randomise_pose,
 };
 use dexcube_operator::{Failure, Operator, OperatorConfig, Outcome, move_plan, set_up_scramble};
+use dexcube_sim::cube::CubeState;
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{Scene, SceneKind, Sim};
 use rand::SeedableRng;
@@ -222,4 +223,37 @@ fn the_opposite_face_up_makes_the_same_move_so_pair_mode_accepts_it() {
             "axis mode rejects the flipped pose: {strict:?}"
         );
     }
+}
+
+/// The randomisation re-seats the cube on a flat hand, as a training episode starts, with
+/// its layers as they were, rather than into the fingers of a clenched one.
+#[test]
+fn randomising_the_pose_flattens_the_hand_and_keeps_the_layers() {
+    let table = DistanceTable::build();
+    let scramble = scrambles_at_distance(&table, 5, 1, 3).remove(0);
+    let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
+    set_up_scramble(&mut sim, &scramble.moves, RESTING);
+    let before = CubeState::read(&sim)
+        .unwrap()
+        .facelets_in_cube_frame()
+        .unwrap();
+    sim.set_action(&[1.0; dexcube_sim::HAND_ACTUATORS]);
+    for _ in 0..10 {
+        sim.step().unwrap();
+    }
+    assert!(
+        sim.hand_angles().iter().any(|a| a.abs() > 0.5),
+        "the hand is bent"
+    );
+    randomise_pose(&mut sim, RESTING, &mut ChaCha8Rng::seed_from_u64(0));
+    assert!(
+        sim.hand_angles().iter().all(|&a| a == 0.0),
+        "the hand is flat"
+    );
+    assert_eq!(sim.object_pose().position, RESTING);
+    let after = CubeState::read(&sim)
+        .unwrap()
+        .facelets_in_cube_frame()
+        .unwrap();
+    assert_eq!(after, before, "the layers are as they were");
 }

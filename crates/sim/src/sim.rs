@@ -76,6 +76,15 @@ impl Sim {
         self.data.forward();
     }
 
+    /// Puts the hand back at its initial pose (every joint at zero: flat and open), at rest,
+    /// leaving the object as it is.
+    pub fn reset_hand(&mut self) {
+        for joint in *self.scene.hand_joints() {
+            self.data.qpos_mut()[joint.qpos] = 0.0;
+            self.data.qvel_mut()[joint.dof] = 0.0;
+        }
+    }
+
     /// Control steps run since this simulation was made, resets and all.
     pub fn control_steps(&self) -> u64 {
         self.control_steps
