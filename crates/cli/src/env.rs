@@ -3,9 +3,11 @@
 
 use std::process::ExitCode;
 
+use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerObject, LayerOpEnv, RotMode};
+use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode};
+use dexcube_sim::Scene;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -36,34 +38,65 @@ pub struct EnvChoice {
     /// LayerOpEnv's move: U U' R R' F F'.
     #[arg(long = "move", default_value = "U'")]
     pub layer_move: LayerMove,
-    /// LayerOpEnv's object: cube (the physical 2x2x2 the operator turns) or block (a
-    /// two-layer block on one hinge, quicker to simulate).
-    #[arg(long, default_value = "cube")]
-    pub object: LayerObject,
+    /// The object on the palm: cube (the physical 2x2x2 the operator turns; LayerOpEnv's
+    /// default), block (LayerOpEnv's two-layer block on one hinge) or rigid (CubeRotEnv's
+    /// rigid cube, its default). Block and rigid are quicker to simulate.
+    #[arg(long)]
+    pub object: Option<ObjectKind>,
 }
 
 impl EnvChoice {
+    /// The object, checked to suit the environment.
+    pub fn object(&self) -> anyhow::Result<ObjectKind> {
+        suited(
+            self.env,
+            self.object.unwrap_or(match self.env {
+                EnvKind::Rot => ObjectKind::Rigid,
+                EnvKind::Layer => ObjectKind::Cube,
+            }),
+        )
+    }
+
     /// Builds the chosen environment; LayerOpEnv samples training goals.
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
+        let scene = Scene::load(self.object()?.scene())?;
         Ok(match self.env {
-            EnvKind::Rot => Box::new(CubeRotEnv::new(self.mode)?),
-            EnvKind::Layer => Box::new(LayerOpEnv::new(
-                self.object,
+            EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene, RotGoal::paper(self.mode))),
+            EnvKind::Layer => Box::new(LayerOpEnv::with_scene(
+                scene,
                 self.layer_move,
                 LayerGoals::Training,
-            )?),
+            )),
         })
     }
 
-    pub fn name(&self) -> String {
-        match self.env {
-            EnvKind::Rot => format!("CubeRotEnv ({} mode)", self.mode.name()),
-            // Block runs keep the label they had before the cube was an option, so they resume.
-            EnvKind::Layer => match self.object {
-                LayerObject::Block => format!("LayerOpEnv ({})", self.layer_move.name()),
-                LayerObject::Cube => format!("LayerOpEnv ({}, cube)", self.layer_move.name()),
-            },
+    /// The run's label. Runs on each environment's original object keep the label they had
+    /// before the object was an option, so they resume.
+    pub fn name(&self) -> anyhow::Result<String> {
+        let object = self.object()?;
+        let what = match self.env {
+            EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
+            EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
+        };
+        Ok(match (self.env, object) {
+            (EnvKind::Rot, ObjectKind::Rigid) | (EnvKind::Layer, ObjectKind::Block) => {
+                format!("{what})")
+            }
+            _ => format!("{what}, {})", object.name()),
+        })
+    }
+}
+
+/// `object`, if `env` can hold it.
+pub fn suited(env: EnvKind, object: ObjectKind) -> anyhow::Result<ObjectKind> {
+    match (env, object) {
+        (EnvKind::Rot, ObjectKind::Block) => {
+            bail!("CubeRotEnv holds the rigid or the physical cube: use --object rigid or cube")
         }
+        (EnvKind::Layer, ObjectKind::Rigid) => {
+            bail!("LayerOpEnv needs a layer to turn: use --object cube or block")
+        }
+        _ => Ok(object),
     }
 }
 
@@ -98,7 +131,7 @@ pub fn run(command: EnvCommand) -> anyhow::Result<ExitCode> {
 fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
     let env = choice.build()?;
     let spaces = env.spaces();
-    println!("{}", choice.name());
+    println!("{}", choice.name()?);
     println!("  observation: {} floats", spaces.observation);
     println!(
         "  goal:        {} floats (achieved_goal and desired_goal)",
@@ -134,7 +167,7 @@ fn rollout(args: &RolloutArgs) -> anyhow::Result<ExitCode> {
     let mut successes = 0;
     println!(
         "{} with the {} policy, seed {}",
-        args.choice.name(),
+        args.choice.name()?,
         policy_name(args.policy),
         args.seed
     );

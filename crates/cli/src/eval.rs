@@ -12,7 +12,7 @@ use clap::{Args, ValueEnum};
 use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeRotEnv, GoalEnv, Info, LayerGoal, LayerMove, LayerObject, LayerOpEnv, RotGoal, RotMode,
+    CubeRotEnv, GoalEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
@@ -21,6 +21,8 @@ use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::env::{EnvKind, suited};
 
 /// The shipped policies, or others.
 #[derive(Args, Clone)]
@@ -327,7 +329,7 @@ pub struct EvalStageArgs {
     policies: PolicyArgs,
     /// Stage 2's object: cube or block (default: the one the policy was trained on).
     #[arg(long)]
-    object: Option<LayerObject>,
+    object: Option<ObjectKind>,
     /// Also write the result into the policy's JSON card, as its evaluation.
     #[arg(long)]
     record: bool,
@@ -403,15 +405,16 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         StageKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
         StageKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
     };
+    let env_kind = match args.stage {
+        StageKind::Rot => EnvKind::Rot,
+        StageKind::Layer => EnvKind::Layer,
+    };
     let object = match args.object {
-        Some(object) => object,
-        None => trained_on(&files.layer)?,
+        Some(object) => suited(env_kind, object)?,
+        None => trained_on(&prefix, env_kind)?,
     };
     let bar = ProgressBar::new(args.episodes as u64);
-    let scene = Scene::load(match args.stage {
-        StageKind::Rot => SceneKind::Rot,
-        StageKind::Layer => object.scene(),
-    })?;
+    let scene = Scene::load(object.scene())?;
     in_parallel(
         args.threads,
         args.episodes,
@@ -440,7 +443,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let (lo, hi) = wilson_interval(wins, args.episodes);
     let rate = wins as f64 / args.episodes as f64;
     let what = match args.stage {
-        StageKind::Rot => format!("Stage 1 (CubeRotEnv, {} mode)", files.rot_mode.name()),
+        StageKind::Rot => format!(
+            "Stage 1 (CubeRotEnv, {} mode, {} cube)",
+            files.rot_mode.name(),
+            match object {
+                ObjectKind::Cube => "physical",
+                _ => "rigid",
+            }
+        ),
         StageKind::Layer => format!(
             "Stage 2 (LayerOpEnv U' on the {}, goal +90°)",
             object.name()
@@ -464,23 +474,28 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The object a Stage 2 policy was trained on, from its card (cards from before the cube was
-/// an option were all trained on the block).
-fn trained_on(layer_policy: &Path) -> anyhow::Result<LayerObject> {
-    let path = layer_policy.with_extension("json");
+/// The object a policy was trained on, from its card (cards from before the object was an
+/// option were trained on the rigid cube for Stage 1 and on the block for Stage 2).
+fn trained_on(policy: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
+    let path = policy.with_extension("json");
     let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
         .with_context(|| format!("reading {}", path.display()))?;
-    card["metadata"]["environment"]["object"]
-        .as_str()
-        .unwrap_or("block")
-        .parse()
-        .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))
+    let object = match card["metadata"]["environment"]["object"].as_str() {
+        Some(name) => name
+            .parse()
+            .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))?,
+        None => match env {
+            EnvKind::Rot => ObjectKind::Rigid,
+            EnvKind::Layer => ObjectKind::Block,
+        },
+    };
+    suited(env, object)
 }
 
 fn record(
     prefix: &Path,
     args: &EvalStageArgs,
-    object: LayerObject,
+    object: ObjectKind,
     successes: usize,
     (lo, hi): (f64, f64),
 ) -> anyhow::Result<()> {
@@ -494,7 +509,7 @@ fn record(
         "ci95": [lo, hi],
         "seed": args.seed,
         "command": match args.stage {
-            StageKind::Rot => format!("dexcube eval-stage rot --episodes {} --seed {}", args.episodes, args.seed),
+            StageKind::Rot => format!("dexcube eval-stage rot --object {} --episodes {} --seed {}", object.name(), args.episodes, args.seed),
             StageKind::Layer => format!("dexcube eval-stage layer --object {} --episodes {} --seed {}", object.name(), args.episodes, args.seed),
         },
     });

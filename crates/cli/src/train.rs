@@ -7,9 +7,9 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, LayerObject, LayerOpEnv, RotGoal};
+use dexcube_env::{CubeRotEnv, LayerOpEnv, ObjectKind, RotGoal};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
-use dexcube_sim::{Scene, SceneKind};
+use dexcube_sim::Scene;
 
 use crate::env::{EnvChoice, EnvKind};
 
@@ -75,16 +75,18 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     if args.quarter_goals && matches!(args.choice.env, EnvKind::Rot) {
         bail!("--quarter-goals is for LayerOpEnv (train layer)");
     }
+    let object = args.choice.object()?;
+    let suffix = match (args.choice.env, object) {
+        (EnvKind::Rot, ObjectKind::Rigid) | (EnvKind::Layer, ObjectKind::Block) => "",
+        _ => "-cube",
+    };
     let (name, variant) = match args.choice.env {
-        EnvKind::Rot => ("rot", args.choice.mode.name().to_string()),
+        EnvKind::Rot => ("rot", args.choice.mode.name().to_string() + suffix),
         EnvKind::Layer => (
             "layer",
             args.choice.layer_move.name().replace('\'', "p")
                 + if args.quarter_goals { "-quarter" } else { "" }
-                + match args.choice.object {
-                    LayerObject::Cube => "-cube",
-                    LayerObject::Block => "",
-                },
+                + suffix,
         ),
     };
     let (out, resume) = match (&args.out, &args.resume) {
@@ -110,15 +112,12 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         init_from: args.init.clone(),
         snapshot_every: args.snapshot_every,
         progress: true,
-        label: args.choice.name(),
+        label: args.choice.name()?,
         metadata: serde_json::json!({
             "env": name,
             "variant": variant,
             "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
-            "object": match args.choice.env {
-                EnvKind::Layer => Some(args.choice.object.name()),
-                EnvKind::Rot => None,
-            },
+            "object": object.name(),
         }),
     };
     eprintln!(
@@ -129,7 +128,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     );
     let trained = match args.choice.env {
         EnvKind::Rot => {
-            let scene = Scene::load(SceneKind::Rot)?;
+            let scene = Scene::load(object.scene())?;
             let goal = RotGoal::paper(args.choice.mode);
             train(
                 || CubeRotEnv::with_scene(scene.clone(), goal),
@@ -138,7 +137,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             )?
         }
         EnvKind::Layer => {
-            let scene = Scene::load(args.choice.object.scene())?;
+            let scene = Scene::load(object.scene())?;
             let layer_move = args.choice.layer_move;
             let goals = if args.quarter_goals {
                 LayerGoals::Evaluation

@@ -245,3 +245,29 @@ fn render_writes_a_picture_and_missing_assets_fail_cleanly() {
     assert_clean_failure(&o, 2, "missing model file /no/such/assets/cube/scene.xml");
     assert!(stderr(&o).contains("scripts/setup"));
 }
+
+#[test]
+fn each_environment_takes_only_objects_it_can_hold() {
+    let layer = dexcube(&["env", "info", "layer"], "");
+    assert!(
+        layer.status.success() && stdout(&layer).contains("LayerOpEnv (U', cube)"),
+        "LayerOpEnv turns the physical cube by default: {}",
+        stdout(&layer)
+    );
+    let rot = dexcube(&["env", "info", "rot", "--object", "cube"], "");
+    assert!(
+        rot.status.success() && stdout(&rot).contains("CubeRotEnv (paper mode, cube)"),
+        "{}",
+        stdout(&rot)
+    );
+    assert_clean_failure(
+        &dexcube(&["env", "info", "rot", "--object", "block"], ""),
+        2,
+        "CubeRotEnv holds the rigid or the physical cube",
+    );
+    assert_clean_failure(
+        &dexcube(&["env", "info", "layer", "--object", "rigid"], ""),
+        2,
+        "LayerOpEnv needs a layer to turn",
+    );
+}

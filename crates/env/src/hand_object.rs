@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use dexcube_sim::rotation::Quat;
-use dexcube_sim::{HAND_ACTUATORS, Pose, Scene, Sim};
+use dexcube_sim::{HAND_ACTUATORS, Pose, Scene, SceneKind, Sim};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -27,6 +27,47 @@ pub const SETTLE_STEPS: usize = 10;
 /// Standard deviation of the object's start position around its resting point, metres
 /// (Gymnasium-Robotics' 0.005).
 const START_POSITION_NOISE: f64 = 0.005;
+
+/// The object on the palm, by scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ObjectKind {
+    /// The physical 2x2x2 cube (`cube` scene): what the operator turns. Both environments.
+    Cube,
+    /// A two-layer block on one hinge (`layer` scene): LayerOpEnv, quicker to simulate.
+    Block,
+    /// A rigid 5 cm cube (`rot` scene): CubeRotEnv, quicker to simulate.
+    Rigid,
+}
+
+impl ObjectKind {
+    pub const ALL: [ObjectKind; 3] = [ObjectKind::Cube, ObjectKind::Block, ObjectKind::Rigid];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ObjectKind::Cube => "cube",
+            ObjectKind::Block => "block",
+            ObjectKind::Rigid => "rigid",
+        }
+    }
+
+    pub fn scene(self) -> SceneKind {
+        match self {
+            ObjectKind::Cube => SceneKind::Cube,
+            ObjectKind::Block => SceneKind::Layer,
+            ObjectKind::Rigid => SceneKind::Rot,
+        }
+    }
+}
+
+impl std::str::FromStr for ObjectKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        ObjectKind::ALL
+            .into_iter()
+            .find(|o| o.name() == s)
+            .ok_or_else(|| format!("unknown object '{s}': use cube, block or rigid"))
+    }
+}
 
 pub struct HandObject {
     pub sim: Sim,

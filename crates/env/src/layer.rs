@@ -1,6 +1,6 @@
 //! LayerOpEnv (Stage 2): turn one layer of a cube on the palm by a quarter turn.
 //!
-//! The layer belongs to one of two objects ([`LayerObject`]): the physical 2x2x2 cube of the
+//! The layer belongs to one of two objects ([`ObjectKind`]): the physical 2x2x2 cube of the
 //! `cube` scene (eight cubelets on ball joints, held in line by a detent), which is what the
 //! operator turns, or a two-layer block on one hinge (the `layer` scene), twice as quick to
 //! simulate.
@@ -31,11 +31,11 @@ use dexcube_cube::Face;
 use dexcube_sim::cube::{CubeState, face_normal, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::scene::{JointAddress, ObjectJoints};
-use dexcube_sim::{Scene, SceneKind, Sim, SimError};
+use dexcube_sim::{Scene, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, LayerGoal, wrap_angle};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, ObjectKind, canonical};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// Which layer faces where, and which way it turns.
@@ -104,41 +104,6 @@ impl std::str::FromStr for LayerMove {
 pub enum LayerGoals {
     Training,
     Evaluation,
-}
-
-/// What the turning layer belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum LayerObject {
-    /// The physical 2x2x2 cube (`cube` scene): what the operator turns.
-    Cube,
-    /// A two-layer block on one hinge (`layer` scene): quicker to simulate.
-    Block,
-}
-
-impl LayerObject {
-    pub fn name(self) -> &'static str {
-        match self {
-            LayerObject::Cube => "cube",
-            LayerObject::Block => "block",
-        }
-    }
-
-    pub fn scene(self) -> SceneKind {
-        match self {
-            LayerObject::Cube => SceneKind::Cube,
-            LayerObject::Block => SceneKind::Layer,
-        }
-    }
-}
-
-impl std::str::FromStr for LayerObject {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        [LayerObject::Cube, LayerObject::Block]
-            .into_iter()
-            .find(|o| o.name() == s)
-            .ok_or_else(|| format!("unknown layer object '{s}': use cube or block"))
-    }
 }
 
 /// Stage 2's view of the physical cube, shared by LayerOpEnv and the operator: the layer
@@ -227,7 +192,7 @@ pub struct LayerOpEnv {
 
 impl LayerOpEnv {
     pub fn new(
-        object: LayerObject,
+        object: ObjectKind,
         layer_move: LayerMove,
         goals: LayerGoals,
     ) -> Result<LayerOpEnv, SimError> {
@@ -267,10 +232,10 @@ impl LayerOpEnv {
         self.layer_move
     }
 
-    pub fn object(&self) -> LayerObject {
+    pub fn object(&self) -> ObjectKind {
         match self.layer {
-            Layer::Block { .. } => LayerObject::Block,
-            Layer::Cube(_) => LayerObject::Cube,
+            Layer::Block { .. } => ObjectKind::Block,
+            Layer::Cube(_) => ObjectKind::Cube,
         }
     }
 

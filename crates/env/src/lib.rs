@@ -25,8 +25,11 @@ use std::sync::Arc;
 
 pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
-pub use hand_object::{DROP_DEPTH, SETTLE_STEPS, base_observation, is_dropped, resting_point};
-pub use layer::{CubeLayer, LayerMove, LayerObject, LayerOpEnv};
+pub use hand_object::{
+    BASE_OBSERVATION, DROP_DEPTH, ObjectKind, SETTLE_STEPS, base_observation, is_dropped,
+    resting_point,
+};
+pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, pose_goal};
 pub use vec_env::VecEnv;
 

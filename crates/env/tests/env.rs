@@ -2,7 +2,7 @@
 
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeLayer, CubeRotEnv, GoalEnv, LayerMove, LayerObject, LayerOpEnv, RotMode, SimulatedEnv,
+    CubeLayer, CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, ObjectKind, RotMode, SimulatedEnv,
     VecEnv,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
@@ -30,7 +30,7 @@ fn spaces_have_the_papers_sizes() {
         (61, 7, 20)
     );
     let mut layer =
-        LayerOpEnv::new(LayerObject::Block, LayerMove::UPrime, LayerGoals::Training).unwrap();
+        LayerOpEnv::new(ObjectKind::Block, LayerMove::UPrime, LayerGoals::Training).unwrap();
     assert_eq!((layer.spaces().observation, layer.spaces().goal), (62, 1));
     let (obs, _) = layer.reset(Some(1));
     assert_eq!(
@@ -80,9 +80,9 @@ fn rewards_agree(env: &mut dyn GoalEnv, episodes: u64) -> usize {
 fn compute_reward_agrees_with_step_on_thousands_of_transitions() {
     let mut rot = CubeRotEnv::new(RotMode::Paper).unwrap();
     let mut block =
-        LayerOpEnv::new(LayerObject::Block, LayerMove::UPrime, LayerGoals::Training).unwrap();
+        LayerOpEnv::new(ObjectKind::Block, LayerMove::UPrime, LayerGoals::Training).unwrap();
     let mut cube =
-        LayerOpEnv::new(LayerObject::Cube, LayerMove::UPrime, LayerGoals::Training).unwrap();
+        LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Training).unwrap();
     let checked =
         rewards_agree(&mut rot, 12) + rewards_agree(&mut block, 12) + rewards_agree(&mut cube, 6);
     assert!(checked > 1000, "{checked}");
@@ -150,7 +150,7 @@ fn rot_success_is_detected_just_inside_and_not_just_outside_the_thresholds() {
 
 #[test]
 fn layer_success_is_detected_within_a_tenth_of_a_radian() {
-    for object in [LayerObject::Block, LayerObject::Cube] {
+    for object in [ObjectKind::Block, ObjectKind::Cube] {
         let mut env = LayerOpEnv::new(object, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
         let (obs, _) = env.reset(Some(5));
         assert_eq!(obs.desired_goal, [FRAC_PI_2]);
@@ -189,7 +189,7 @@ fn layer_success_is_detected_within_a_tenth_of_a_radian() {
 #[test]
 fn the_cube_is_seen_through_the_layer_that_stays_whichever_face_is_up() {
     let mut env =
-        LayerOpEnv::new(LayerObject::Cube, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
+        LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
     let orientation = |o: &[f64]| [o[51], o[52], o[53], o[54]];
     let (mut frame_carried_by_the_turn, mut frame_kept) = (0, 0);
     for seed in 0..12 {
@@ -280,7 +280,7 @@ fn a_dropped_cube_ends_the_episode_as_a_failure() {
 fn a_blown_up_simulation_resets_that_env_only() {
     let envs = (0..2)
         .map(|_| {
-            LayerOpEnv::new(LayerObject::Block, LayerMove::UPrime, LayerGoals::Training).unwrap()
+            LayerOpEnv::new(ObjectKind::Block, LayerMove::UPrime, LayerGoals::Training).unwrap()
         })
         .collect();
     let mut vec_env = VecEnv::new(envs, 2);

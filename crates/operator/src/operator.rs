@@ -6,7 +6,9 @@
 //! 2. **Stage 2** turns the top layer U', once for a primed move, three times otherwise. With
 //!    rollback, the cube is checked for a good state (every layer aligned); if it is not, it
 //!    is restored: its layers are worked back to the nearest quarter turn and it is re-seated
-//!    at a random pose (a simulation shortcut for the paper's "randomisation").
+//!    at a random pose on a flat hand (a simulation shortcut for the paper's
+//!    "randomisation"); the move's remaining turns are then skipped, since another face may
+//!    now be up, and the check below re-plans.
 //! 3. With rollback, the facelets read from the physics are compared with the expected ones;
 //!    if the move did not happen, the operator re-plans from what it sees.
 //!
@@ -244,6 +246,11 @@ impl Operator<'_> {
                     narrate(&Event::Randomised(
                         "not in a good state: layers restored, random pose",
                     ));
+                }
+                // A restored cube lies in a random pose: the rest of this move's turns
+                // would turn whatever face is up. The move check re-plans from here.
+                if restores > 0 {
+                    break;
                 }
             }
         }

@@ -8,11 +8,11 @@ use std::f64::consts::FRAC_PI_2;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS, base_observation,
-    is_dropped, pose_goal,
+    BASE_OBSERVATION, CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS,
+    base_observation, is_dropped, pose_goal,
 };
 use dexcube_rl::Policy;
-use dexcube_sim::cube::{face_toward, turn_face_by};
+use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{HAND_ACTUATORS, Pose, Sim};
 use rand_chacha::ChaCha8Rng;
@@ -166,20 +166,23 @@ const UP: [f64; 3] = [0.0, 0.0, 1.0];
 
 impl Stage2 for PolicyStage2 {
     fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let Some(mut view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
+        let Some(view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
             return StageRun::default();
         };
+        let view = std::cell::RefCell::new(view);
         let goal = [FRAC_PI_2];
         let policy = &self.policy;
-        let turned = std::cell::Cell::new(0.0);
         drive(
             sim,
+            |sim| policy.act(&view.borrow_mut().observe(sim), &goal),
+            // Done once the layer is a quarter turn round and the cube is in a good state:
+            // stopping at the first reading within 0.1 rad of the turn can leave a cubelet
+            // tilted beyond what the detent pulls back.
             |sim| {
-                let observation = view.observe(sim);
-                turned.set(view.turned());
-                policy.act(&observation, &goal)
+                let turned = view.borrow_mut().observe(sim)[BASE_OBSERVATION];
+                LayerGoal::default().is_success(&[turned], &goal)
+                    && CubeState::read(sim).is_some_and(|s| s.is_aligned())
             },
-            |_| LayerGoal::default().is_success(&[turned.get()], &goal),
             self.resting_z,
             watch,
         )
@@ -222,15 +225,23 @@ impl Stage2 for KinematicStage2 {
 }
 
 /// Re-seats the cube on the palm at a uniformly random orientation, keeping its layers as
-/// they are: the paper's randomisation before Stage 1 is repeated. The hand is put back flat,
-/// as at the start of a training episode, so that the cube is not seated into its fingers.
+/// they are: the paper's randomisation before Stage 1 is repeated. It is done as a training
+/// episode starts: the hand is put back flat, the cube set down near `position` and left to
+/// settle under the neutral action, and set down afresh, up to ten times, if it rolls off.
 pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
-    sim.reset_hand();
-    sim.set_object_pose(&Pose {
-        position,
-        orientation: uniform_rotation(rng),
-    });
-    sim.forward();
+    for _ in 0..10 {
+        sim.reset_hand();
+        sim.set_object_pose(&Pose {
+            position,
+            orientation: uniform_rotation(rng),
+        });
+        sim.forward();
+        sim.set_action(&[0.0; HAND_ACTUATORS]);
+        let settled = (0..SETTLE_STEPS).all(|_| sim.step().is_ok());
+        if settled && !is_dropped(sim, position[2]) {
+            return;
+        }
+    }
 }
 
 /// The rollback's pose check after Stage 1: CubeRotEnv's success test in `mode`, judged on
