@@ -8,8 +8,8 @@ use std::process::ExitCode;
 
 use clap::Args;
 use dexcube_cube::{DistanceTable, format_moves, scrambles_at_distance};
-use dexcube_operator::Event;
 use dexcube_operator::eval::{Hooks, resting_point, run_cube};
+use dexcube_operator::{Event, Failure};
 use dexcube_sim::render::{DEFAULT_CAMERA, Frame, FrameRenderer, save_video};
 use dexcube_sim::{Scene, SceneKind, Sim};
 
@@ -100,6 +100,13 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
                 format!("  Stage 2: U' on the top layer ({turn} of {of})")
             }
             Event::Randomised(why) => format!("  rollback: {why}"),
+            Event::Ended { stage, failure } => format!(
+                "  Stage {stage} ended the attempt: {}",
+                match failure {
+                    Failure::Diverged => "the physics blew up",
+                    _ => "the cube fell off the hand",
+                }
+            ),
             Event::MoveDone(m) => format!("move {m} done"),
             Event::Replan(plan) => format!(
                 "  rollback: the move did not happen; new plan: {}",

@@ -84,6 +84,11 @@ pub enum Event {
     Randomised(&'static str),
     MoveDone(Move),
     Replan(Vec<Move>),
+    /// A stage ended the attempt: the cube fell, or the physics blew up.
+    Ended {
+        stage: usize,
+        failure: Failure,
+    },
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -208,6 +213,7 @@ impl Operator<'_> {
         for attempt in 1..=self.config.stage1_attempts {
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
             if let Some(failure) = outcome.count(&run) {
+                narrate(&Event::Ended { stage: 1, failure });
                 return Some(failure);
             }
             let ok = (self.stage1_accepts)(sim, self.resting, target);
@@ -230,8 +236,9 @@ impl Operator<'_> {
             let run = self.stage2.run(sim, &mut *self.watch);
             let failure = outcome.count(&run);
             narrate(&Event::Stage2 { turn, of: turns });
-            if failure.is_some() {
-                return failure;
+            if let Some(failure) = failure {
+                narrate(&Event::Ended { stage: 2, failure });
+                return Some(failure);
             }
             if self.config.rollback {
                 let mut restores = 0;
