@@ -469,7 +469,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         }
     }
     if args.record {
-        record(&prefix, &args, object, wins, (lo, hi))?;
+        let own = object == trained_on(&prefix, env_kind)?;
+        record(&prefix, &args, (object, own), wins, (lo, hi))?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -492,17 +493,24 @@ fn trained_on(policy: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
     suited(env, object)
 }
 
+/// Writes the result into the policy's card: as `evaluation` on the object it was trained on
+/// (`own`), as `evaluation_on_<object>` on another, so both can stand side by side.
 fn record(
     prefix: &Path,
     args: &EvalStageArgs,
-    object: ObjectKind,
+    (object, own): (ObjectKind, bool),
     successes: usize,
     (lo, hi): (f64, f64),
 ) -> anyhow::Result<()> {
     let path = prefix.with_extension("json");
     let mut card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
         .with_context(|| format!("reading {}", path.display()))?;
-    card["metadata"]["evaluation"] = serde_json::json!({
+    let key = if own {
+        "evaluation".to_string()
+    } else {
+        format!("evaluation_on_{}", object.name())
+    };
+    card["metadata"][key] = serde_json::json!({
         "episodes": args.episodes,
         "successes": successes,
         "success_rate": successes as f64 / args.episodes as f64,

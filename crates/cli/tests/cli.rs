@@ -271,3 +271,83 @@ fn each_environment_takes_only_objects_it_can_hold() {
         "LayerOpEnv needs a layer to turn",
     );
 }
+
+/// `eval-stage --record` writes the figure on the policy's own object as its evaluation, and
+/// one on another object beside it; an object the stage cannot hold is refused.
+#[test]
+fn eval_stage_records_each_object_under_its_own_name() {
+    let dir = std::env::temp_dir().join("dexcube-cli-eval-stage");
+    std::fs::create_dir_all(&dir).unwrap();
+    for ext in ["json", "safetensors"] {
+        std::fs::copy(
+            models().join("layer").with_extension(ext),
+            dir.join("layer").with_extension(ext),
+        )
+        .unwrap();
+    }
+    let layer = dir.join("layer");
+    let layer = layer.to_str().unwrap();
+    let rot = models().join("rot");
+    let rot = rot.to_str().unwrap();
+    let run = |object: &str| {
+        let o = dexcube(
+            &[
+                "eval-stage",
+                "layer",
+                "--episodes",
+                "2",
+                "--seed",
+                "7",
+                "--threads",
+                "1",
+                "--layer-policy",
+                layer,
+                "--rot-policy",
+                rot,
+                "--object",
+                object,
+                "--record",
+            ],
+            "",
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    assert!(run("block").contains("on the block"));
+    assert!(run("cube").contains("on the cube"));
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("layer.json")).unwrap()).unwrap();
+    let metadata = &card["metadata"];
+    assert_eq!(metadata["evaluation"]["episodes"], 2);
+    assert!(
+        metadata["evaluation"]["command"]
+            .as_str()
+            .unwrap()
+            .contains("--object block")
+    );
+    assert!(
+        metadata["evaluation_on_cube"]["command"]
+            .as_str()
+            .unwrap()
+            .contains("--object cube")
+    );
+    assert_clean_failure(
+        &dexcube(
+            &[
+                "eval-stage",
+                "rot",
+                "--episodes",
+                "2",
+                "--object",
+                "block",
+                "--rot-policy",
+                rot,
+                "--layer-policy",
+                layer,
+            ],
+            "",
+        ),
+        2,
+        "CubeRotEnv holds the rigid or the physical cube",
+    );
+}
