@@ -19,7 +19,7 @@ pub enum EnvCommand {
     Rollout(RolloutArgs),
 }
 
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum EnvKind {
     /// CubeRotEnv, Stage 1.
     Rot,

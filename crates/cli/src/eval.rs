@@ -345,15 +345,18 @@ enum Ending {
     /// Position reached, orientation (or layer angle) not.
     AngleOff,
     BothOff,
+    /// Stage 2: the layer ended within 22.5° of where it began (it never turned).
+    NeverTurned,
 }
 
 impl Ending {
-    const ALL: [Ending; 5] = [
+    const ALL: [Ending; 6] = [
         Ending::Success,
         Ending::Dropped,
         Ending::PositionOff,
         Ending::AngleOff,
         Ending::BothOff,
+        Ending::NeverTurned,
     ];
 
     fn name(self) -> &'static str {
@@ -363,15 +366,21 @@ impl Ending {
             Ending::PositionOff => "missed on position only",
             Ending::AngleOff => "missed on angle only",
             Ending::BothOff => "missed on both",
+            Ending::NeverTurned => "missed: the layer never turned (within 22.5° of its start)",
         }
     }
 
-    fn of(info: &Info, (position, angle): (f64, f64)) -> Ending {
+    /// Stage 2's misses by an angle error of more than 67.5° from the quarter turn are the
+    /// layer never turning (`turning` is true for Stage 2).
+    fn of(info: &Info, (position, angle): (f64, f64), turning: bool) -> Ending {
         if info.is_success {
             return Ending::Success;
         }
         if info.dropped || info.physics_error.is_some() {
             return Ending::Dropped;
+        }
+        if turning && info.angle_error > 3.0 * std::f64::consts::FRAC_PI_8 {
+            return Ending::NeverTurned;
         }
         match (info.position_error >= position, info.angle_error >= angle) {
             (true, false) => Ending::PositionOff,
@@ -399,7 +408,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         StageKind::Rot => files.rot.clone(),
         StageKind::Layer => files.layer.clone(),
     };
-    let endings: [AtomicUsize; 5] = Default::default();
+    let endings: [AtomicUsize; 6] = Default::default();
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
         StageKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
@@ -432,7 +441,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         },
         |(policy, env), k| {
             let info = episode(env.as_mut(), policy, args.seed + k as u64);
-            endings[Ending::of(&info, thresholds) as usize].fetch_add(1, Ordering::Relaxed);
+            endings[Ending::of(&info, thresholds, env_kind == EnvKind::Layer) as usize]
+                .fetch_add(1, Ordering::Relaxed);
             bar.inc(1);
             Ok(())
         },
@@ -523,4 +533,31 @@ fn record(
     });
     write_atomically(&path, serde_json::to_string_pretty(&card)?.as_bytes())?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stage_2_misses_that_never_turned_the_layer_are_told_apart() {
+        let miss = |angle_error: f64| Info {
+            angle_error,
+            ..Info::default()
+        };
+        let layer = (f64::INFINITY, 0.1);
+        assert!(Ending::of(&miss(1.5), layer, true) == Ending::NeverTurned);
+        assert!(Ending::of(&miss(0.3), layer, true) == Ending::AngleOff);
+        assert!(Ending::of(&miss(1.5), (0.01, 0.1), false) == Ending::AngleOff);
+        let dropped = Info {
+            dropped: true,
+            ..miss(1.5)
+        };
+        assert!(Ending::of(&dropped, layer, true) == Ending::Dropped);
+        let success = Info {
+            is_success: true,
+            ..Info::default()
+        };
+        assert!(Ending::of(&success, layer, true) == Ending::Success);
+    }
 }

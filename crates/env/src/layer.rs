@@ -335,7 +335,12 @@ impl GoalEnv for LayerOpEnv {
                 facing,
                 rng.random_range(-std::f64::consts::PI..std::f64::consts::PI),
             );
-            let face = faces[rng.random_range(0..faces.len())];
+            // (The block draws nothing here, so its episodes stay as they were before the
+            // cube was an option.)
+            let face = match faces.len() {
+                1 => faces[0],
+                n => faces[rng.random_range(0..n)],
+            };
             rotation::normalise(&rotation::mul(&rotation::mul(&spin, &base), &face))
         });
         if let Layer::Cube(tracker) = &mut self.layer {
