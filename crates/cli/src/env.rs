@@ -78,12 +78,20 @@ impl EnvChoice {
             EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
-        Ok(match (self.env, object) {
-            (EnvKind::Rot, ObjectKind::Rigid) | (EnvKind::Layer, ObjectKind::Block) => {
-                format!("{what})")
-            }
-            _ => format!("{what}, {})", object.name()),
+        Ok(if object == original_object(self.env) {
+            format!("{what})")
+        } else {
+            format!("{what}, {})", object.name())
         })
+    }
+}
+
+/// The object each environment held before the object was an option: runs and cards on it
+/// keep their old names.
+pub fn original_object(env: EnvKind) -> ObjectKind {
+    match env {
+        EnvKind::Rot => ObjectKind::Rigid,
+        EnvKind::Layer => ObjectKind::Block,
     }
 }
 

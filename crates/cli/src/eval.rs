@@ -8,7 +8,7 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::{Context, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
@@ -22,7 +22,7 @@ use dexcube_rl::checkpoint::write_atomically;
 use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::env::{EnvKind, suited};
+use crate::env::{EnvKind, original_object, suited};
 
 /// The shipped policies, or others.
 #[derive(Args, Clone)]
@@ -305,19 +305,13 @@ fn check_same_run(out: &Path, files: &PolicyFiles, seed: u64) -> anyhow::Result<
     Ok(())
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-pub enum StageKind {
-    /// Stage 1: CubeRotEnv with the policy's own success test, the paper's three targets.
-    Rot,
-    /// Stage 2: LayerOpEnv U' with the goal exactly +90°.
-    Layer,
-}
-
 /// Success rate of one atomic action alone, with a 95% confidence interval.
 #[derive(Args)]
 pub struct EvalStageArgs {
     #[arg(value_enum)]
-    stage: StageKind,
+    /// rot: Stage 1, CubeRotEnv with the policy's own success test and the paper's three
+    /// targets; layer: Stage 2, LayerOpEnv U' with the goal exactly +90°.
+    stage: EnvKind,
     #[arg(long, default_value_t = 1000)]
     episodes: usize,
     /// Episode i is reset with seed + i.
@@ -405,22 +399,19 @@ fn episode(env: &mut dyn GoalEnv, policy: &Policy, seed: u64) -> Info {
 pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let files = args.policies.files()?;
     let prefix = match args.stage {
-        StageKind::Rot => files.rot.clone(),
-        StageKind::Layer => files.layer.clone(),
+        EnvKind::Rot => files.rot.clone(),
+        EnvKind::Layer => files.layer.clone(),
     };
     let endings: [AtomicUsize; 6] = Default::default();
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
-        StageKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
-        StageKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
+        EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
+        EnvKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
     };
-    let env_kind = match args.stage {
-        StageKind::Rot => EnvKind::Rot,
-        StageKind::Layer => EnvKind::Layer,
-    };
+    let trained = trained_on(&prefix, args.stage)?;
     let object = match args.object {
-        Some(object) => suited(env_kind, object)?,
-        None => trained_on(&prefix, env_kind)?,
+        Some(object) => suited(args.stage, object)?,
+        None => trained,
     };
     let bar = ProgressBar::new(args.episodes as u64);
     let scene = Scene::load(object.scene())?;
@@ -430,8 +421,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         || -> anyhow::Result<(Policy, Box<dyn GoalEnv>)> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
             let env: Box<dyn GoalEnv> = match args.stage {
-                StageKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
-                StageKind::Layer => Box::new(LayerOpEnv::with_scene(
+                EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
+                EnvKind::Layer => Box::new(LayerOpEnv::with_scene(
                     scene.clone(),
                     LayerMove::UPrime,
                     LayerGoals::Evaluation,
@@ -441,7 +432,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         },
         |(policy, env), k| {
             let info = episode(env.as_mut(), policy, args.seed + k as u64);
-            endings[Ending::of(&info, thresholds, env_kind == EnvKind::Layer) as usize]
+            endings[Ending::of(&info, thresholds, args.stage == EnvKind::Layer) as usize]
                 .fetch_add(1, Ordering::Relaxed);
             bar.inc(1);
             Ok(())
@@ -453,7 +444,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let (lo, hi) = wilson_interval(wins, args.episodes);
     let rate = wins as f64 / args.episodes as f64;
     let what = match args.stage {
-        StageKind::Rot => format!(
+        EnvKind::Rot => format!(
             "Stage 1 (CubeRotEnv, {} mode, {} cube)",
             files.rot_mode.name(),
             match object {
@@ -461,7 +452,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 _ => "rigid",
             }
         ),
-        StageKind::Layer => format!(
+        EnvKind::Layer => format!(
             "Stage 2 (LayerOpEnv U' on the {}, goal +90°)",
             object.name()
         ),
@@ -479,8 +470,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         }
     }
     if args.record {
-        let own = object == trained_on(&prefix, env_kind)?;
-        record(&prefix, &args, (object, own), wins, (lo, hi))?;
+        record(&prefix, &args, (object, object == trained), wins, (lo, hi))?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -495,10 +485,7 @@ fn trained_on(policy: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
         Some(name) => name
             .parse()
             .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))?,
-        None => match env {
-            EnvKind::Rot => ObjectKind::Rigid,
-            EnvKind::Layer => ObjectKind::Block,
-        },
+        None => original_object(env),
     };
     suited(env, object)
 }
@@ -526,10 +513,16 @@ fn record(
         "success_rate": successes as f64 / args.episodes as f64,
         "ci95": [lo, hi],
         "seed": args.seed,
-        "command": match args.stage {
-            StageKind::Rot => format!("dexcube eval-stage rot --object {} --episodes {} --seed {}", object.name(), args.episodes, args.seed),
-            StageKind::Layer => format!("dexcube eval-stage layer --object {} --episodes {} --seed {}", object.name(), args.episodes, args.seed),
-        },
+        "command": format!(
+            "dexcube eval-stage {} --object {} --episodes {} --seed {}",
+            match args.stage {
+                EnvKind::Rot => "rot",
+                EnvKind::Layer => "layer",
+            },
+            object.name(),
+            args.episodes,
+            args.seed
+        ),
     });
     write_atomically(&path, serde_json::to_string_pretty(&card)?.as_bytes())?;
     Ok(())

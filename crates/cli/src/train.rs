@@ -7,11 +7,11 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, LayerOpEnv, ObjectKind, RotGoal};
+use dexcube_env::{CubeRotEnv, LayerOpEnv, RotGoal};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
 use dexcube_sim::Scene;
 
-use crate::env::{EnvChoice, EnvKind};
+use crate::env::{EnvChoice, EnvKind, original_object};
 
 /// How training collects experience, shared by `train` and `bench rl`. Eight environments
 /// on two threads balance physics against the 40 batches of a cycle on a 2-core machine.
@@ -76,17 +76,18 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         bail!("--quarter-goals is for LayerOpEnv (train layer)");
     }
     let object = args.choice.object()?;
-    let suffix = match (args.choice.env, object) {
-        (EnvKind::Rot, ObjectKind::Rigid) | (EnvKind::Layer, ObjectKind::Block) => "",
-        _ => "-cube",
+    let suffix = if object == original_object(args.choice.env) {
+        String::new()
+    } else {
+        format!("-{}", object.name())
     };
     let (name, variant) = match args.choice.env {
-        EnvKind::Rot => ("rot", args.choice.mode.name().to_string() + suffix),
+        EnvKind::Rot => ("rot", args.choice.mode.name().to_string() + &suffix),
         EnvKind::Layer => (
             "layer",
             args.choice.layer_move.name().replace('\'', "p")
                 + if args.quarter_goals { "-quarter" } else { "" }
-                + suffix,
+                + &suffix,
         ),
     };
     let (out, resume) = match (&args.out, &args.resume) {
@@ -126,9 +127,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         out.display(),
         seed
     );
+    let scene = Scene::load(object.scene())?;
     let trained = match args.choice.env {
         EnvKind::Rot => {
-            let scene = Scene::load(object.scene())?;
             let goal = RotGoal::paper(args.choice.mode);
             train(
                 || CubeRotEnv::with_scene(scene.clone(), goal),
@@ -137,7 +138,6 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             )?
         }
         EnvKind::Layer => {
-            let scene = Scene::load(object.scene())?;
             let layer_move = args.choice.layer_move;
             let goals = if args.quarter_goals {
                 LayerGoals::Evaluation

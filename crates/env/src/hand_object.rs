@@ -114,12 +114,11 @@ impl HandObject {
                 *p += START_POSITION_NOISE * standard_normal(&mut self.rng);
             }
             let orientation = orientation(&mut self.rng);
-            self.sim.set_object_pose(&Pose {
+            let pose = Pose {
                 position,
                 orientation,
-            });
-            self.sim.forward();
-            if settle(&mut self.sim) && !self.dropped() {
+            };
+            if set_down(&mut self.sim, &pose, self.resting[2]) {
                 break;
             }
         }
@@ -236,6 +235,15 @@ pub fn resting_point(sim: &mut Sim) -> [f64; 3] {
     } else {
         start.position
     }
+}
+
+/// Sets the object down at `pose` and lets it settle with the neutral action, as every
+/// episode starts; false if the physics blew up or the object fell `DROP_DEPTH` below
+/// `resting_z`.
+pub fn set_down(sim: &mut Sim, pose: &Pose, resting_z: f64) -> bool {
+    sim.set_object_pose(pose);
+    sim.forward();
+    settle(sim) && !is_dropped(sim, resting_z)
 }
 
 /// Lets the object settle with a neutral action; false if the physics blew up.

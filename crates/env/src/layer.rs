@@ -28,7 +28,7 @@ use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
 
 use dexcube_cube::Face;
-use dexcube_sim::cube::{CubeState, face_normal, face_toward, turn_face_by};
+use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::scene::{JointAddress, ObjectJoints};
 use dexcube_sim::{Scene, Sim, SimError};
@@ -232,13 +232,6 @@ impl LayerOpEnv {
         self.layer_move
     }
 
-    pub fn object(&self) -> ObjectKind {
-        match self.layer {
-            Layer::Block { .. } => ObjectKind::Block,
-            Layer::Cube(_) => ObjectKind::Cube,
-        }
-    }
-
     /// The angle between the layers: on the block in (-π, π], on the cube as turned since
     /// the episode's start.
     pub fn layer_angle(&self) -> f64 {
@@ -258,13 +251,9 @@ impl LayerOpEnv {
                 data.qvel_mut()[hinge.dof] = 0.0;
             }
             Layer::Cube(tracker) => {
-                let facing = self.layer_move.facing();
-                let world_face = Face::ALL
-                    .into_iter()
-                    .find(|&f| face_normal(f) == facing)
-                    .expect("moves face along an axis");
+                // The face named as seen in the world, which is where the move's layer faces.
+                let world_face = face_toward(&rotation::IDENTITY, self.layer_move.facing());
                 turn_face_by(&mut self.hand.sim, world_face, change);
-                self.hand.sim.forward();
                 tracker.turned_by(&self.hand.sim, change);
             }
         }
@@ -325,21 +314,19 @@ impl GoalEnv for LayerOpEnv {
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
         self.hand.seed(seed);
         let (facing, base) = (self.layer_move.facing(), self.layer_move.base_orientation());
-        // On the cube any face may be the turning one: its cubelets are alike.
-        let faces = match self.layer {
-            Layer::Block { .. } => vec![rotation::IDENTITY],
-            Layer::Cube(_) => rotation::cube_group().to_vec(),
-        };
+        // On the cube any face may be the turning one: its cubelets are alike. The block
+        // draws nothing more, so its episodes stay as they were before the cube was an option.
+        let any_face = matches!(self.layer, Layer::Cube(_));
         self.hand.place(|rng| {
             let spin = rotation::about(
                 facing,
                 rng.random_range(-std::f64::consts::PI..std::f64::consts::PI),
             );
-            // (The block draws nothing here, so its episodes stay as they were before the
-            // cube was an option.)
-            let face = match faces.len() {
-                1 => faces[0],
-                n => faces[rng.random_range(0..n)],
+            let face = if any_face {
+                let group = rotation::cube_group();
+                group[rng.random_range(0..group.len())]
+            } else {
+                rotation::IDENTITY
             };
             rotation::normalise(&rotation::mul(&rotation::mul(&spin, &base), &face))
         });

@@ -57,7 +57,7 @@ impl CubeRotEnv {
         ))
     }
 
-    /// A CubeRotEnv over an already loaded `rot` scene (shared between environments).
+    /// A CubeRotEnv over an already loaded `rot` or `cube` scene (shared between environments).
     pub fn with_scene(scene: Arc<Scene>, goal: RotGoal) -> CubeRotEnv {
         let hand = HandObject::new(scene);
         let desired = pose_goal(hand.resting, PAPER_TARGETS[0]);

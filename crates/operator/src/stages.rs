@@ -9,7 +9,7 @@ use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
     BASE_OBSERVATION, CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS,
-    base_observation, is_dropped, pose_goal,
+    base_observation, is_dropped, pose_goal, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
@@ -52,64 +52,45 @@ pub struct StageRun {
     pub diverged: bool,
 }
 
-/// Runs a policy for up to an episode, stopping early when `done` says so. First the hand
-/// opens flat (the model's zero pose) and then takes the neutral action, `SETTLE_STEPS`
-/// each, with the cube on its palm: every training episode starts that way, from a hand
-/// placed flat and left to settle, while the previous stage leaves the fingers wherever it
-/// ended (the paper's "problematic end states"). Going straight to the neutral action from
-/// such an end state throws the cube off the palm. These steps count as control steps, not
-/// as an action.
+/// Runs a policy for up to an episode: `act` gives the next action, or `None` once the stage
+/// is done. First the hand opens flat (the model's zero pose) and then takes the neutral
+/// action, `SETTLE_STEPS` each, with the cube on its palm: every training episode starts that
+/// way, from a hand placed flat and left to settle, while the previous stage leaves the
+/// fingers wherever it ended (the paper's "problematic end states"). Going straight to the
+/// neutral action from such an end state throws the cube off the palm. These steps count as
+/// control steps, not as an action.
 fn drive(
     sim: &mut Sim,
-    mut act: impl FnMut(&Sim) -> Vec<f64>,
-    mut done: impl FnMut(&Sim) -> bool,
+    act: impl FnMut(&Sim) -> Option<Vec<f64>>,
     resting_z: f64,
     watch: Watch,
 ) -> StageRun {
     let mut run = StageRun::default();
     let open = sim.scene().open_hand_action().to_vec();
     for relax in [open, vec![0.0; HAND_ACTUATORS]] {
-        let hold = |_: &Sim| relax.clone();
-        if !advance(
-            sim,
-            hold,
-            |_| false,
-            SETTLE_STEPS,
-            resting_z,
-            watch,
-            &mut run,
-        ) {
+        let hold = |_: &Sim| Some(relax.clone());
+        if !advance(sim, hold, SETTLE_STEPS, resting_z, watch, &mut run) {
             return run;
         }
     }
-    advance(
-        sim,
-        &mut act,
-        &mut done,
-        EPISODE_STEPS,
-        resting_z,
-        watch,
-        &mut run,
-    );
+    advance(sim, act, EPISODE_STEPS, resting_z, watch, &mut run);
     run
 }
 
-/// Up to `steps` control steps of `act`, stopping early when `done` says so; false if the
+/// Up to `steps` control steps of `act`, stopping early when it has no action; false if the
 /// cube dropped or the physics blew up (noted in `run`).
 fn advance(
     sim: &mut Sim,
-    mut act: impl FnMut(&Sim) -> Vec<f64>,
-    mut done: impl FnMut(&Sim) -> bool,
+    mut act: impl FnMut(&Sim) -> Option<Vec<f64>>,
     steps: usize,
     resting_z: f64,
     watch: Watch,
     run: &mut StageRun,
 ) -> bool {
     for _ in 0..steps {
-        if done(sim) {
+        let Some(action) = act(sim) else {
             break;
-        }
-        let action = act(sim);
+        };
         let mut clipped = [0.0; HAND_ACTUATORS];
         for (c, a) in clipped.iter_mut().zip(&action) {
             *c = a.clamp(-1.0, 1.0);
@@ -142,8 +123,9 @@ impl Stage1 for PolicyStage1 {
         let policy = &self.policy;
         drive(
             sim,
-            |sim| policy.act(&base_observation(sim), &goal),
-            |sim| reached(sim, position, target),
+            |sim| {
+                (!reached(sim, position, target)).then(|| policy.act(&base_observation(sim), &goal))
+            },
             position[2],
             watch,
         )
@@ -166,22 +148,21 @@ const UP: [f64; 3] = [0.0, 0.0, 1.0];
 
 impl Stage2 for PolicyStage2 {
     fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let Some(view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
+        let Some(mut view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
             return StageRun::default();
         };
-        let view = std::cell::RefCell::new(view);
         let goal = [FRAC_PI_2];
         let policy = &self.policy;
         drive(
             sim,
-            |sim| policy.act(&view.borrow_mut().observe(sim), &goal),
-            // Done once the layer is a quarter turn round and the cube is in a good state:
-            // stopping at the first reading within 0.1 rad of the turn can leave a cubelet
-            // tilted beyond what the detent pulls back.
             |sim| {
-                let turned = view.borrow_mut().observe(sim)[BASE_OBSERVATION];
-                LayerGoal::default().is_success(&[turned], &goal)
-                    && CubeState::read(sim).is_some_and(|s| s.is_aligned())
+                let observation = view.observe(sim);
+                // Done once the layer is a quarter turn round and the cube is in a good
+                // state: stopping at the first reading within 0.1 rad of the turn can leave
+                // a cubelet tilted beyond what the detent pulls back.
+                let done = LayerGoal::default().is_success(&[observation[BASE_OBSERVATION]], &goal)
+                    && CubeState::read(sim).is_some_and(|s| s.is_aligned());
+                (!done).then(|| policy.act(&observation, &goal))
             },
             self.resting_z,
             watch,
@@ -231,14 +212,11 @@ impl Stage2 for KinematicStage2 {
 pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
     for _ in 0..10 {
         sim.reset_hand();
-        sim.set_object_pose(&Pose {
+        let pose = Pose {
             position,
             orientation: uniform_rotation(rng),
-        });
-        sim.forward();
-        sim.set_action(&[0.0; HAND_ACTUATORS]);
-        let settled = (0..SETTLE_STEPS).all(|_| sim.step().is_ok());
-        if settled && !is_dropped(sim, position[2]) {
+        };
+        if set_down(sim, &pose, position[2]) {
             return;
         }
     }

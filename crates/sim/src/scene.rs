@@ -215,9 +215,7 @@ impl Scene {
             ctrl[i] = self.ctrl_centre[i] + a * self.ctrl_half_range[i];
         }
     }
-}
 
-impl Scene {
     /// The action whose targets are the model's zero pose (the open, flat hand every
     /// episode starts from), clamped into the actuators' ranges.
     pub fn open_hand_action(&self) -> [f64; HAND_ACTUATORS] {
