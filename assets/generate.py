@@ -121,7 +121,12 @@ def cube_scene():
               "       Stiff (solref 0.004): with MuJoCo's default a 9 g cubelet under a fingertip's",
               "       0.5 N sinks centimetres into its neighbour and a jammed cube flexes. Frictionless:",
               "       one constraint row per contact; a layer's resistance to turning is its ball",
-              "       joints' damping, and its alignment the detent in crates/sim/src/cube.rs. -->",
+              "       joints' damping, and its alignment the detent in crates/sim/src/cube.rs.",
+              "       Each cubelet resists as the block's hinge does (damping and frictionloss 0.0005):",
+              "       with damping 0.002 and no friction the block-trained U' policy turned the layer",
+              "       in 40% of 1000 episodes; the viscous drag, not the detent, held it back. The",
+              "       friction keeps a squeezed or landing cube's layers from creeping (results/",
+              "       TRAINING.md, session 4). -->",
               "  <contact>"]
     for i, p in enumerate(CORNERS):
         for q in CORNERS[i + 1:]:
@@ -145,7 +150,7 @@ def cube_scene():
     lines += cubelet_geoms("DBL", "      ")
     for c in CORNERS[:-1]:
         lines += [f'      <body name="cubelet:{c}">',
-                  f'        <joint name="cubelet:{c}" type="ball" damping="0.002"/>']
+                  f'        <joint name="cubelet:{c}" type="ball" damping="0.0005" frictionloss="0.0005"/>']
         lines += cubelet_geoms(c, "        ")
         lines.append("      </body>")
     lines += ["    </body>", "  </worldbody>", "</mujoco>"]

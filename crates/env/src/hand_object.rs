@@ -4,6 +4,7 @@
 
 use std::sync::Arc;
 
+use dexcube_sim::cube::CubeState;
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{HAND_ACTUATORS, Pose, Scene, SceneKind, Sim};
 use rand::SeedableRng;
@@ -238,12 +239,15 @@ pub fn resting_point(sim: &mut Sim) -> [f64; 3] {
 }
 
 /// Sets the object down at `pose` and lets it settle with the neutral action, as every
-/// episode starts; false if the physics blew up or the object fell `DROP_DEPTH` below
-/// `resting_z`.
+/// episode starts; false if the physics blew up, the object fell `DROP_DEPTH` below
+/// `resting_z`, or a physical cube landed with a layer knocked out of its good state (about
+/// one landing in ten on a flat hand).
 pub fn set_down(sim: &mut Sim, pose: &Pose, resting_z: f64) -> bool {
     sim.set_object_pose(pose);
     sim.forward();
-    settle(sim) && !is_dropped(sim, resting_z)
+    settle(sim)
+        && !is_dropped(sim, resting_z)
+        && CubeState::read(sim).is_none_or(|cube| cube.is_aligned())
 }
 
 /// Lets the object settle with a neutral action; false if the physics blew up.

@@ -9,7 +9,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
 use dexcube_cube::Face;
 use dexcube_sim::Pose;
-use dexcube_sim::cube::turn_face_by;
+use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, turn_face_by};
 use dexcube_sim::rotation::{self, about};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -164,12 +164,13 @@ fn layer_success_is_detected_within_a_tenth_of_a_radian() {
             env.set_layer_angle(FRAC_PI_2 + offset);
             let t = env.step(&[0.0; 20]);
             let (a, d) = (&t.observation.achieved_goal, &t.observation.desired_goal);
+            // One step of physics moves the layer a little, and on the cube the detent may
+            // pull a layer within its capture back to the quarter turn: judge what was read.
+            let read = a[0] - FRAC_PI_2;
             assert!(
-                (a[0] - (FRAC_PI_2 + offset)).abs() < 0.05,
-                "{object:?}: set {offset} past a quarter turn, read {}",
-                a[0] - FRAC_PI_2
+                (read - offset).abs() < 0.05 || (object == ObjectKind::Cube && read.abs() < 0.02),
+                "{object:?}: set {offset} past a quarter turn, read {read}"
             );
-            // One step of physics moves the layer a little: judge what was achieved.
             assert_eq!(env.goal().is_success(a, d), (a[0] - d[0]).abs() < 0.1);
             let exact = env.goal().is_success(&[FRAC_PI_2 + offset], d);
             assert_eq!(exact, success, "{object:?}: offset {offset}");
@@ -303,4 +304,20 @@ fn a_blown_up_simulation_resets_that_env_only() {
             .iter()
             .all(|s| s.transition.info.physics_error.is_none())
     );
+}
+
+/// About one landing in ten on the flat hand knocks a layer of the physical cube out of its
+/// good state; such a start is set down again, so every episode starts with a turnable cube.
+#[test]
+fn every_episode_on_the_physical_cube_starts_in_a_good_state() {
+    let mut env =
+        LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
+    for seed in 2_000_000..2_000_040 {
+        env.reset(Some(seed));
+        let misalignment = CubeState::read(env.sim()).unwrap().misalignment();
+        assert!(
+            misalignment < ALIGNED_TOLERANCE,
+            "seed {seed}: the cube starts {misalignment:.3} rad off a quarter turn"
+        );
+    }
 }
