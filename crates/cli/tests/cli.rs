@@ -318,18 +318,20 @@ fn eval_stage_records_each_object_under_its_own_name() {
     let card: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("layer.json")).unwrap()).unwrap();
     let metadata = &card["metadata"];
+    // The shipped Stage 2 was trained on the physical cube: the block is the other object.
+    assert_eq!(metadata["environment"]["object"], "cube");
     assert_eq!(metadata["evaluation"]["episodes"], 2);
     assert!(
         metadata["evaluation"]["command"]
             .as_str()
             .unwrap()
-            .contains("--object block")
+            .contains("--object cube")
     );
     assert!(
-        metadata["evaluation_on_cube"]["command"]
+        metadata["evaluation_on_block"]["command"]
             .as_str()
             .unwrap()
-            .contains("--object cube")
+            .contains("--object block")
     );
     assert_clean_failure(
         &dexcube(

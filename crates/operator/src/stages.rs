@@ -8,8 +8,8 @@ use std::f64::consts::FRAC_PI_2;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    BASE_OBSERVATION, CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS,
-    base_observation, is_dropped, pose_goal, set_down,
+    CubeLayer, EPISODE_STEPS, Goal, RotGoal, RotMode, SETTLE_STEPS, base_observation, is_dropped,
+    pose_goal, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
@@ -52,23 +52,25 @@ pub struct StageRun {
     pub diverged: bool,
 }
 
-/// Runs a policy for up to an episode: `act` gives the next action, or `None` once the stage
-/// is done. First the hand opens flat (the model's zero pose) and then takes the neutral
-/// action, `SETTLE_STEPS` each, with the cube on its palm: every training episode starts that
-/// way, from a hand placed flat and left to settle, while the previous stage leaves the
-/// fingers wherever it ended (the paper's "problematic end states"). Going straight to the
-/// neutral action from such an end state throws the cube off the palm. These steps count as
-/// control steps, not as an action.
+/// Runs a policy for a whole episode, as its training and `eval-stage` do: the policies learn
+/// to reach their goal by the episode's last step and hold it there, so the operator judges
+/// the stage at the end, not at the first step the goal is met (a cube caught mid-turn and
+/// then let go was dropped half again as often). First the hand opens flat (the model's zero
+/// pose) and then takes the neutral action, `SETTLE_STEPS` each, with the cube on its palm:
+/// every training episode starts that way, from a hand placed flat and left to settle, while
+/// the previous stage leaves the fingers wherever it ended (the paper's "problematic end
+/// states"). Going straight to the neutral action from such an end state throws the cube off
+/// the palm. These steps count as control steps, not as an action.
 fn drive(
     sim: &mut Sim,
-    act: impl FnMut(&Sim) -> Option<Vec<f64>>,
+    act: impl FnMut(&Sim) -> Vec<f64>,
     resting_z: f64,
     watch: Watch,
 ) -> StageRun {
     let mut run = StageRun::default();
     let open = sim.scene().open_hand_action().to_vec();
     for relax in [open, vec![0.0; HAND_ACTUATORS]] {
-        let hold = |_: &Sim| Some(relax.clone());
+        let hold = |_: &Sim| relax.clone();
         if !advance(sim, hold, SETTLE_STEPS, resting_z, watch, &mut run) {
             return run;
         }
@@ -77,20 +79,18 @@ fn drive(
     run
 }
 
-/// Up to `steps` control steps of `act`, stopping early when it has no action; false if the
-/// cube dropped or the physics blew up (noted in `run`).
+/// `steps` control steps of `act`; false if the cube dropped or the physics blew up (noted in
+/// `run`).
 fn advance(
     sim: &mut Sim,
-    mut act: impl FnMut(&Sim) -> Option<Vec<f64>>,
+    mut act: impl FnMut(&Sim) -> Vec<f64>,
     steps: usize,
     resting_z: f64,
     watch: Watch,
     run: &mut StageRun,
 ) -> bool {
     for _ in 0..steps {
-        let Some(action) = act(sim) else {
-            break;
-        };
+        let action = act(sim);
         let mut clipped = [0.0; HAND_ACTUATORS];
         for (c, a) in clipped.iter_mut().zip(&action) {
             *c = a.clamp(-1.0, 1.0);
@@ -119,13 +119,10 @@ pub struct PolicyStage1 {
 impl Stage1 for PolicyStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
         let goal = pose_goal(position, target);
-        let reached = pose_reached(self.mode);
         let policy = &self.policy;
         drive(
             sim,
-            |sim| {
-                (!reached(sim, position, target)).then(|| policy.act(&base_observation(sim), &goal))
-            },
+            |sim| policy.act(&base_observation(sim), &goal),
             position[2],
             watch,
         )
@@ -155,15 +152,7 @@ impl Stage2 for PolicyStage2 {
         let policy = &self.policy;
         drive(
             sim,
-            |sim| {
-                let observation = view.observe(sim);
-                // Done once the layer is a quarter turn round and the cube is in a good
-                // state: stopping at the first reading within 0.1 rad of the turn can leave
-                // a cubelet tilted beyond what the detent pulls back.
-                let done = LayerGoal::default().is_success(&[observation[BASE_OBSERVATION]], &goal)
-                    && CubeState::read(sim).is_some_and(|s| s.is_aligned());
-                (!done).then(|| policy.act(&observation, &goal))
-            },
+            |sim| policy.act(&view.observe(sim), &goal),
             self.resting_z,
             watch,
         )
@@ -208,10 +197,15 @@ impl Stage2 for KinematicStage2 {
 /// Re-seats the cube on the palm at a uniformly random orientation, keeping its layers as
 /// they are: the paper's randomisation before Stage 1 is repeated. It is done as a training
 /// episode starts: the hand is put back flat, the cube set down near `position` and left to
-/// settle under the neutral action, and set down afresh, up to ten times, if it rolls off.
+/// settle under the neutral action, and set down afresh, up to ten times, if it rolls off or
+/// lands with a layer knocked out of square (each try starts from the layers as they were).
 pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
+    let layers = CubeState::read(sim);
     for _ in 0..10 {
         sim.reset_hand();
+        if let Some(layers) = &layers {
+            layers.restore_layers(sim);
+        }
         let pose = Pose {
             position,
             orientation: uniform_rotation(rng),

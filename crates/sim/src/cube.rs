@@ -61,6 +61,17 @@ impl CubeState {
         })
     }
 
+    /// Puts every cubelet back to its rotation in this reading, velocities zeroed, leaving the
+    /// cube's pose as it is now: its layers as they were read. Call `Sim::forward` (or step)
+    /// after.
+    pub fn restore_layers(&self, sim: &mut Sim) {
+        if let Some(balls) = sim.scene().object().cube_balls() {
+            for (slot, ball) in balls.into_iter().enumerate() {
+                sim.set_ball(ball, &self.rotations[slot]);
+            }
+        }
+    }
+
     /// The cube's centre and its frame's orientation in the world.
     pub fn pose(&self) -> Pose {
         self.pose
@@ -196,9 +207,10 @@ pub fn turn_face_by(sim: &mut Sim, face: Face, angle: f64) -> bool {
     let Some(state) = CubeState::read(sim) else {
         return false;
     };
-    // The same face in the cube's own frame.
-    let (frame, _) = rotation::snap_to_cube(&state.pose.orientation, rotation::cube_group());
-    let face = face_at(rotation::rotate(&rotation::conj(&frame), face_normal(face)));
+    // The same face in the cube's own frame: the one pointing most nearly along the world
+    // face's normal, as `face_toward` names it for Stage 2 (a cube tilted near 45° can snap
+    // to a frame with another face up).
+    let face = face_toward(&state.pose.orientation, face_normal(face));
     let turn = rotation::about(face_normal(face), angle);
     let in_layer: Vec<bool> = state
         .rotations
