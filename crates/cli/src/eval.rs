@@ -12,13 +12,14 @@ use clap::Args;
 use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeRotEnv, GoalEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode,
+    CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode, SimulatedEnv,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
+use dexcube_sim::cube::CubeState;
 use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -341,16 +342,20 @@ enum Ending {
     BothOff,
     /// Stage 2: the layer ended within 22.5° of where it began (it never turned).
     NeverTurned,
+    /// Stage 2 on the physical cube: the layer never turned, and the cube ended out of its
+    /// good state (another layer gave way, or the layer stuck part-way).
+    Jammed,
 }
 
 impl Ending {
-    const ALL: [Ending; 6] = [
+    const ALL: [Ending; 7] = [
         Ending::Success,
         Ending::Dropped,
         Ending::PositionOff,
         Ending::AngleOff,
         Ending::BothOff,
         Ending::NeverTurned,
+        Ending::Jammed,
     ];
 
     fn name(self) -> &'static str {
@@ -361,12 +366,16 @@ impl Ending {
             Ending::AngleOff => "missed on angle only",
             Ending::BothOff => "missed on both",
             Ending::NeverTurned => "missed: the layer never turned (within 22.5° of its start)",
+            Ending::Jammed => {
+                "missed: the layer never turned, and the cube ended out of its good state"
+            }
         }
     }
 
     /// Stage 2's misses by an angle error of more than 67.5° from the quarter turn are the
-    /// layer never turning (`turning` is true for Stage 2).
-    fn of(info: &Info, (position, angle): (f64, f64), turning: bool) -> Ending {
+    /// layer never turning (`turning` is true for Stage 2), told apart by whether the cube
+    /// ended `square` (in its good state; a rigid object always is).
+    fn of(info: &Info, (position, angle): (f64, f64), turning: bool, square: bool) -> Ending {
         if info.is_success {
             return Ending::Success;
         }
@@ -374,7 +383,11 @@ impl Ending {
             return Ending::Dropped;
         }
         if turning && info.angle_error > 3.0 * std::f64::consts::FRAC_PI_8 {
-            return Ending::NeverTurned;
+            return if square {
+                Ending::NeverTurned
+            } else {
+                Ending::Jammed
+            };
         }
         match (info.position_error >= position, info.angle_error >= angle) {
             (true, false) => Ending::PositionOff,
@@ -384,13 +397,15 @@ impl Ending {
     }
 }
 
-/// Runs a deterministic episode and returns its last step's info.
-fn episode(env: &mut dyn GoalEnv, policy: &Policy, seed: u64) -> Info {
+/// Runs a deterministic episode and returns its last step's info, and whether the object
+/// ended square (a physical cube in its good state; any other object always).
+fn episode(env: &mut dyn SimulatedEnv, policy: &Policy, seed: u64) -> (Info, bool) {
     let (mut obs, _) = env.reset(Some(seed));
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
         if t.terminated || t.truncated {
-            return t.info;
+            let square = CubeState::read(env.sim()).is_none_or(|cube| cube.is_aligned());
+            return (t.info, square);
         }
         obs = t.observation;
     }
@@ -402,7 +417,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         EnvKind::Rot => files.rot.clone(),
         EnvKind::Layer => files.layer.clone(),
     };
-    let endings: [AtomicUsize; 6] = Default::default();
+    let endings: [AtomicUsize; 7] = Default::default();
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
         EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
@@ -418,9 +433,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     in_parallel(
         args.threads,
         args.episodes,
-        || -> anyhow::Result<(Policy, Box<dyn GoalEnv>)> {
+        || -> anyhow::Result<(Policy, Box<dyn SimulatedEnv>)> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
-            let env: Box<dyn GoalEnv> = match args.stage {
+            let env: Box<dyn SimulatedEnv> = match args.stage {
                 EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
                 EnvKind::Layer => Box::new(LayerOpEnv::with_scene(
                     scene.clone(),
@@ -431,8 +446,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             Ok((policy, env))
         },
         |(policy, env), k| {
-            let info = episode(env.as_mut(), policy, args.seed + k as u64);
-            endings[Ending::of(&info, thresholds, args.stage == EnvKind::Layer) as usize]
+            let (info, square) = episode(env.as_mut(), policy, args.seed + k as u64);
+            endings[Ending::of(&info, thresholds, args.stage == EnvKind::Layer, square) as usize]
                 .fetch_add(1, Ordering::Relaxed);
             bar.inc(1);
             Ok(())
@@ -539,18 +554,19 @@ mod tests {
             ..Info::default()
         };
         let layer = (f64::INFINITY, 0.1);
-        assert!(Ending::of(&miss(1.5), layer, true) == Ending::NeverTurned);
-        assert!(Ending::of(&miss(0.3), layer, true) == Ending::AngleOff);
-        assert!(Ending::of(&miss(1.5), (0.01, 0.1), false) == Ending::AngleOff);
+        assert!(Ending::of(&miss(1.5), layer, true, true) == Ending::NeverTurned);
+        assert!(Ending::of(&miss(1.5), layer, true, false) == Ending::Jammed);
+        assert!(Ending::of(&miss(0.3), layer, true, false) == Ending::AngleOff);
+        assert!(Ending::of(&miss(1.5), (0.01, 0.1), false, true) == Ending::AngleOff);
         let dropped = Info {
             dropped: true,
             ..miss(1.5)
         };
-        assert!(Ending::of(&dropped, layer, true) == Ending::Dropped);
+        assert!(Ending::of(&dropped, layer, true, false) == Ending::Dropped);
         let success = Info {
             is_success: true,
             ..Info::default()
         };
-        assert!(Ending::of(&success, layer, true) == Ending::Success);
+        assert!(Ending::of(&success, layer, true, true) == Ending::Success);
     }
 }
