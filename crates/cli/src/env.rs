@@ -27,6 +27,16 @@ pub enum EnvKind {
     Layer,
 }
 
+impl EnvKind {
+    /// The name on the command line, and of run folders.
+    pub fn name(self) -> &'static str {
+        match self {
+            EnvKind::Rot => "rot",
+            EnvKind::Layer => "layer",
+        }
+    }
+}
+
 #[derive(Args)]
 pub struct EnvChoice {
     #[arg(value_enum)]
@@ -73,16 +83,21 @@ impl EnvChoice {
     /// The run's label. Runs on each environment's original object keep the label they had
     /// before the object was an option, so they resume.
     pub fn name(&self) -> anyhow::Result<String> {
-        let object = self.object()?;
         let what = match self.env {
             EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
-        Ok(if object == original_object(self.env) {
-            format!("{what})")
-        } else {
-            format!("{what}, {})", object.name())
+        Ok(match self.named_object()? {
+            None => format!("{what})"),
+            Some(object) => format!("{what}, {})", object.name()),
         })
+    }
+
+    /// The object, when it is not the environment's original one and so is named in the
+    /// run's label and folder.
+    pub fn named_object(&self) -> anyhow::Result<Option<ObjectKind>> {
+        let object = self.object()?;
+        Ok((object != original_object(self.env)).then_some(object))
     }
 }
 

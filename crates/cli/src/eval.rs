@@ -13,13 +13,13 @@ use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
     CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode, SimulatedEnv,
+    is_square,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
-use dexcube_sim::cube::CubeState;
 use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -404,8 +404,7 @@ fn episode(env: &mut dyn SimulatedEnv, policy: &Policy, seed: u64) -> (Info, boo
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
         if t.terminated || t.truncated {
-            let square = CubeState::read(env.sim()).is_none_or(|cube| cube.is_aligned());
-            return (t.info, square);
+            return (t.info, is_square(env.sim()));
         }
         obs = t.observation;
     }
@@ -530,10 +529,7 @@ fn record(
         "seed": args.seed,
         "command": format!(
             "dexcube eval-stage {} --object {} --episodes {} --seed {}",
-            match args.stage {
-                EnvKind::Rot => "rot",
-                EnvKind::Layer => "layer",
-            },
+            args.stage.name(),
             object.name(),
             args.episodes,
             args.seed

@@ -11,7 +11,7 @@ use dexcube_env::{CubeRotEnv, LayerOpEnv, RotGoal};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
 use dexcube_sim::Scene;
 
-use crate::env::{EnvChoice, EnvKind, original_object};
+use crate::env::{EnvChoice, EnvKind};
 
 /// How training collects experience, shared by `train` and `bench rl`. Eight environments
 /// on two threads balance physics against the 40 batches of a cycle on a 2-core machine.
@@ -76,20 +76,20 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         bail!("--quarter-goals is for LayerOpEnv (train layer)");
     }
     let object = args.choice.object()?;
-    let suffix = if object == original_object(args.choice.env) {
-        String::new()
-    } else {
-        format!("-{}", object.name())
-    };
-    let (name, variant) = match args.choice.env {
-        EnvKind::Rot => ("rot", args.choice.mode.name().to_string() + &suffix),
-        EnvKind::Layer => (
-            "layer",
+    let suffix = args
+        .choice
+        .named_object()?
+        .map(|object| format!("-{}", object.name()))
+        .unwrap_or_default();
+    let variant = match args.choice.env {
+        EnvKind::Rot => args.choice.mode.name().to_string() + &suffix,
+        EnvKind::Layer => {
             args.choice.layer_move.name().replace('\'', "p")
                 + if args.quarter_goals { "-quarter" } else { "" }
-                + &suffix,
-        ),
+                + &suffix
+        }
     };
+    let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
         (Some(dir), None) => (dir.clone(), false),

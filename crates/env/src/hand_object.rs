@@ -106,23 +106,20 @@ impl HandObject {
     }
 
     /// Resets the hand and puts the object on the palm with `orientation`, near the resting
-    /// point, then lets it settle. Tries again, up to ten times, if it rolls off.
+    /// point, then lets it settle ([`set_down`]).
     pub fn place(&mut self, orientation: impl Fn(&mut ChaCha8Rng) -> Quat) {
-        for _ in 0..10 {
-            self.sim.reset();
-            let mut position = self.resting;
+        let (resting, rng) = (self.resting, &mut self.rng);
+        set_down(&mut self.sim, resting[2], |sim| {
+            sim.reset();
+            let mut position = resting;
             for p in &mut position {
-                *p += START_POSITION_NOISE * standard_normal(&mut self.rng);
+                *p += START_POSITION_NOISE * standard_normal(rng);
             }
-            let orientation = orientation(&mut self.rng);
-            let pose = Pose {
+            Pose {
                 position,
-                orientation,
-            };
-            if set_down(&mut self.sim, &pose, self.resting[2]) {
-                break;
+                orientation: orientation(rng),
             }
-        }
+        });
         self.steps = 0;
     }
 
@@ -238,16 +235,26 @@ pub fn resting_point(sim: &mut Sim) -> [f64; 3] {
     }
 }
 
-/// Sets the object down at `pose` and lets it settle with the neutral action, as every
-/// episode starts; false if the physics blew up, the object fell `DROP_DEPTH` below
-/// `resting_z`, or a physical cube landed with a layer knocked out of its good state (about
-/// one landing in ten on a flat hand).
-pub fn set_down(sim: &mut Sim, pose: &Pose, resting_z: f64) -> bool {
-    sim.set_object_pose(pose);
-    sim.forward();
-    settle(sim)
-        && !is_dropped(sim, resting_z)
-        && CubeState::read(sim).is_none_or(|cube| cube.is_aligned())
+/// How many times [`set_down`] tries before it keeps a bad landing.
+const SET_DOWN_TRIES: usize = 10;
+
+/// Sets the object down and lets it settle with the neutral action, as every episode starts:
+/// `prepare` readies the simulation for a try and names the pose. Tries again, up to ten
+/// times, if the physics blew up, the object fell `DROP_DEPTH` below `resting_z`, or it did
+/// not land square (a physical cube with a layer knocked out of its good state: about one
+/// landing in ten on a flat hand). False if every try failed.
+pub fn set_down(sim: &mut Sim, resting_z: f64, mut prepare: impl FnMut(&mut Sim) -> Pose) -> bool {
+    (0..SET_DOWN_TRIES).any(|_| {
+        let pose = prepare(sim);
+        sim.set_object_pose(&pose);
+        sim.forward();
+        settle(sim) && !is_dropped(sim, resting_z) && is_square(sim)
+    })
+}
+
+/// Whether the object is square: a physical cube in its good state; any other object always.
+pub fn is_square(sim: &Sim) -> bool {
+    CubeState::read(sim).is_none_or(|cube| cube.is_aligned())
 }
 
 /// Lets the object settle with a neutral action; false if the physics blew up.

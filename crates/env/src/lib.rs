@@ -27,7 +27,7 @@ pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{
     BASE_OBSERVATION, DROP_DEPTH, ObjectKind, SETTLE_STEPS, base_observation, is_dropped,
-    resting_point, set_down,
+    is_square, resting_point, set_down,
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, pose_goal};

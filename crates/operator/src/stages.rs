@@ -201,19 +201,16 @@ impl Stage2 for KinematicStage2 {
 /// lands with a layer knocked out of square (each try starts from the layers as they were).
 pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
     let layers = CubeState::read(sim);
-    for _ in 0..10 {
+    set_down(sim, position[2], |sim| {
         sim.reset_hand();
         if let Some(layers) = &layers {
             layers.restore_layers(sim);
         }
-        let pose = Pose {
+        Pose {
             position,
             orientation: uniform_rotation(rng),
-        };
-        if set_down(sim, &pose, position[2]) {
-            return;
         }
-    }
+    });
 }
 
 /// The rollback's pose check after Stage 1: CubeRotEnv's success test in `mode`, judged on
