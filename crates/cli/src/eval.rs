@@ -49,17 +49,30 @@ impl PolicyArgs {
                 );
             }
         }
-        let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(
-            self.rot_policy.with_extension("json"),
-        )?)?;
-        let mode = card["metadata"]["environment"]["variant"]
-            .as_str()
-            .unwrap_or("paper");
+        let card_path = self.rot_policy.with_extension("json");
+        let card: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&card_path)?)
+                .with_context(|| format!("{} is not a policy card (JSON)", card_path.display()))?;
         Ok(PolicyFiles {
             rot: self.rot_policy.clone(),
             layer: self.layer_policy.clone(),
-            rot_mode: mode.parse().unwrap_or(RotMode::Paper),
+            rot_mode: rot_mode_of(&card)
+                .with_context(|| format!("reading Stage 1's mode from {}", card_path.display()))?,
         })
+    }
+}
+
+/// The CubeRotEnv success test a Stage 1 card was trained with: its `mode`, or for cards
+/// written before that field the first word of its variant ("pair" of "pair-cube"). A card
+/// that names neither was trained in the paper's mode.
+fn rot_mode_of(card: &serde_json::Value) -> anyhow::Result<RotMode> {
+    let environment = &card["metadata"]["environment"];
+    let named = environment["mode"]
+        .as_str()
+        .or_else(|| environment["variant"].as_str()?.split('-').next());
+    match named {
+        Some(mode) => mode.parse().map_err(anyhow::Error::msg),
+        None => Ok(RotMode::Paper),
     }
 }
 
@@ -564,5 +577,26 @@ mod tests {
             ..Info::default()
         };
         assert!(Ending::of(&success, layer, true, true) == Ending::Success);
+    }
+
+    #[test]
+    fn stage_1_mode_is_read_from_the_card_and_an_unknown_one_is_an_error() {
+        let card = |environment: serde_json::Value| serde_json::json!({ "metadata": { "environment": environment } });
+        let mode = |environment| rot_mode_of(&card(environment)).ok();
+        assert_eq!(
+            mode(serde_json::json!({ "variant": "pair" })),
+            Some(RotMode::Pair)
+        );
+        // A run on the physical cube is named "pair-cube"; it used to be judged in paper mode.
+        assert_eq!(
+            mode(serde_json::json!({ "variant": "pair-cube" })),
+            Some(RotMode::Pair)
+        );
+        assert_eq!(
+            mode(serde_json::json!({ "variant": "pair-cube", "mode": "axis" })),
+            Some(RotMode::Axis)
+        );
+        assert_eq!(mode(serde_json::json!({})), Some(RotMode::Paper));
+        assert_eq!(mode(serde_json::json!({ "variant": "twirl" })), None);
     }
 }

@@ -32,6 +32,7 @@ enum Command {
     Demo(demo::DemoArgs),
     Render(render::RenderArgs),
     Train(train::TrainArgs),
+    Plot(train::PlotArgs),
     Eval(eval::EvalArgs),
     EvalStage(eval::EvalStageArgs),
     /// Inspects the training environments.
@@ -51,6 +52,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(args),
         Command::Env(command) => env::run(command),
         Command::Train(args) => train::run(args),
+        Command::Plot(args) => train::plot(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),
         Command::Bench(command) => bench::run(command),

@@ -63,6 +63,20 @@ pub struct TrainArgs {
     no_her: bool,
 }
 
+/// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
+/// trained on a machine that could not draw it (no fonts).
+#[derive(Args)]
+pub struct PlotArgs {
+    /// The run's folder, as written by `dexcube train` (it holds checkpoint/state.json).
+    run: PathBuf,
+}
+
+pub fn plot(args: PlotArgs) -> anyhow::Result<ExitCode> {
+    let path = dexcube_rl::train::replot(&args.run)?;
+    println!("{}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let Workers {
         envs,
@@ -119,6 +133,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "variant": variant,
             "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
             "object": object.name(),
+            "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
         }),
     };
     eprintln!(

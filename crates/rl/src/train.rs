@@ -128,6 +128,7 @@ pub enum TrainError {
     Checkpoint(CheckpointError),
     Resume(String),
     WarmStart(String),
+    Plot(String),
 }
 
 impl std::fmt::Display for TrainError {
@@ -136,6 +137,7 @@ impl std::fmt::Display for TrainError {
             TrainError::Checkpoint(e) => e.fmt(f),
             TrainError::Resume(message) => write!(f, "cannot resume: {message}"),
             TrainError::WarmStart(message) => write!(f, "cannot warm-start: {message}"),
+            TrainError::Plot(message) => write!(f, "cannot draw the learning curve: {message}"),
         }
     }
 }
@@ -384,25 +386,44 @@ fn save_epoch(
         .chain(metrics.iter().map(EpochMetrics::csv_row))
         .collect();
     checkpoint::write_atomically(&dir.join("metrics.csv"), (csv.join("\n") + "\n").as_bytes())?;
+    if let Err(e) = plot_learning_curve(dir, &options.label, options.seed, metrics) {
+        eprintln!("warning: no learning-curve plot: {e}");
+    }
+    Ok(())
+}
+
+/// Draws DIR/success.png: test success against training episodes.
+fn plot_learning_curve(
+    dir: &Path,
+    label: &str,
+    seed: u64,
+    metrics: &[EpochMetrics],
+) -> Result<PathBuf, String> {
     let curve = Series {
-        label: format!("test success (seed {})", options.seed),
+        label: format!("test success (seed {seed})"),
         points: metrics
             .iter()
             .map(|m| (m.episodes as f64, m.test_success))
             .collect(),
         band: None,
     };
-    if let Err(e) = line_plot(
-        &dir.join("success.png"),
-        &options.label,
+    let path = dir.join("success.png");
+    line_plot(
+        &path,
+        label,
         "training episodes",
         "test success rate",
         1.0,
         &[curve],
-    ) {
-        eprintln!("warning: no learning-curve plot: {e}");
-    }
-    Ok(())
+    )?;
+    Ok(path)
+}
+
+/// Redraws the learning curve of the run in `dir` from its checkpoint, for a run trained
+/// where plots could not be drawn (a machine without fonts); returns the PNG's path.
+pub fn replot(dir: &Path) -> Result<PathBuf, TrainError> {
+    let state: TrainState = checkpoint::load_json(&dir.join("checkpoint").join("state.json"))?;
+    plot_learning_curve(dir, &state.label, state.seed, &state.metrics).map_err(TrainError::Plot)
 }
 
 fn resume(

@@ -55,6 +55,15 @@ fn a_run_writes_its_files_and_resumes_where_it_stopped() {
     }
     let csv = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "a header and two epochs");
+    // The curve can be redrawn from the checkpoint alone (a run trained without fonts).
+    std::fs::remove_file(dir.join("success.png")).unwrap();
+    assert_eq!(
+        dexcube_rl::train::replot(&dir).unwrap(),
+        dir.join("success.png")
+    );
+    assert!(dir.join("success.png").is_file(), "success.png redrawn");
+    let missing = dexcube_rl::train::replot(&dir.join("no-such-run")).unwrap_err();
+    assert!(missing.to_string().contains("state.json"), "{missing}");
     let saved =
         dexcube_rl::checkpoint::load_tensors(&dir.join("checkpoint/actor.safetensors")).unwrap();
     let resumed = train(PointMassEnv::default, config(), &options(&dir, 4, true)).unwrap();
