@@ -13,7 +13,7 @@ use dexcube_operator::{Event, Failure};
 use dexcube_sim::render::{DEFAULT_CAMERA, Frame, FrameRenderer, save_video};
 use dexcube_sim::{Scene, SceneKind, Sim};
 
-use crate::eval::PolicyArgs;
+use crate::eval::{OperatorArgs, PolicyArgs};
 use crate::net;
 
 /// Scrambles a cube and has the hand solve it with the shipped policies.
@@ -33,6 +33,8 @@ pub struct DemoArgs {
     no_rollback: bool,
     #[command(flatten)]
     policies: PolicyArgs,
+    #[command(flatten)]
+    operator: OperatorArgs,
 }
 
 pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
@@ -96,6 +98,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
                     if *ok { "pose reached" } else { "pose off" }
                 )
             }
+            Event::AlreadyUp(face) => format!("  Stage 1: not needed, {face} is already up"),
             Event::Stage2 { turn, of } => {
                 format!("  Stage 2: U' on the top layer ({turn} of {of})")
             }
@@ -120,7 +123,11 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         watch: &mut watch,
         narrate: &mut narrate,
     };
-    let job = (scramble.moves.as_slice(), !args.no_rollback, args.seed);
+    let job = (
+        scramble.moves.as_slice(),
+        args.operator.config(!args.no_rollback),
+        args.seed,
+    );
     let outcome = run_cube(&mut stages, &scene, &table, job, hooks);
     let mut out = io::stdout().lock();
     match outcome.failure {

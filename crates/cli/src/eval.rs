@@ -15,6 +15,7 @@ use dexcube_env::{
     CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode, SimulatedEnv,
     is_square,
 };
+use dexcube_operator::OperatorConfig;
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
@@ -24,6 +25,35 @@ use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::env::{EnvKind, original_object, suited};
+
+/// Which operator runs the plan.
+#[derive(Args, Clone, Copy)]
+pub struct OperatorArgs {
+    /// The paper's operator: the solver's first optimal plan, and Stage 1 before every move.
+    /// By default the operator plans for the hand: of the optimal plans, the one of fewest
+    /// atomic actions, and no Stage 1 when the face to turn is already up.
+    #[arg(long)]
+    pub paper_operator: bool,
+}
+
+impl OperatorArgs {
+    pub fn config(self, rollback: bool) -> OperatorConfig {
+        OperatorConfig {
+            rollback,
+            plan_for_hand: !self.paper_operator,
+            ..OperatorConfig::default()
+        }
+    }
+
+    /// The operator's name in a run's record.
+    fn name(self) -> &'static str {
+        if self.paper_operator {
+            "paper"
+        } else {
+            "planning for the hand"
+        }
+    }
+}
 
 /// The shipped policies, or others.
 #[derive(Args, Clone)]
@@ -101,6 +131,8 @@ pub struct EvalArgs {
     out: PathBuf,
     #[command(flatten)]
     policies: PolicyArgs,
+    #[command(flatten)]
+    operator: OperatorArgs,
 }
 
 fn parse_distances(text: &str) -> anyhow::Result<Vec<usize>> {
@@ -131,7 +163,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     };
     let table_all = DistanceTable::build();
     let csv = args.out.with_extension("csv");
-    check_same_run(&args.out, &files, args.seed)?;
+    check_same_run(&args.out, &files, args.seed, args.operator)?;
     let mut results: Vec<CubeResult> = std::fs::read_to_string(&csv)
         .map(|text| {
             text.lines()
@@ -213,7 +245,8 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 watch: &mut |_| {},
                 narrate: &mut |_| {},
             };
-            let outcome = run_cube(stages, &scene, &table_all, (moves, *rollback, seed), hooks);
+            let job = (moves.as_slice(), args.operator.config(*rollback), seed);
+            let outcome = run_cube(stages, &scene, &table_all, job, hooks);
             let row = CubeResult {
                 distance: *d,
                 index: *i,
@@ -289,12 +322,18 @@ fn fingerprint(path: &Path) -> anyhow::Result<String> {
     Ok(format!("{hash:016x}"))
 }
 
-/// A rerun may only continue PREFIX.csv if it was made with the same policies (by content)
-/// and seed; PREFIX.run.json records them. More cubes per distance, or more distances, are
-/// fine: scrambles at a seed are prefix-stable.
-fn check_same_run(out: &Path, files: &PolicyFiles, seed: u64) -> anyhow::Result<()> {
+/// A rerun may only continue PREFIX.csv if it was made with the same policies (by content),
+/// seed and operator; PREFIX.run.json records them. More cubes per distance, or more
+/// distances, are fine: scrambles at a seed are prefix-stable.
+fn check_same_run(
+    out: &Path,
+    files: &PolicyFiles,
+    seed: u64,
+    operator: OperatorArgs,
+) -> anyhow::Result<()> {
     let identity = serde_json::json!({
         "seed": seed,
+        "operator": operator.name(),
         "rot_policy": fingerprint(&files.rot.with_extension("safetensors"))?,
         "layer_policy": fingerprint(&files.layer.with_extension("safetensors"))?,
     });
@@ -305,7 +344,7 @@ fn check_same_run(out: &Path, files: &PolicyFiles, seed: u64) -> anyhow::Result<
             .and_then(|text| serde_json::from_str(&text).ok());
         if before.as_ref() != Some(&identity) {
             bail!(
-                "{} holds results of other policies or another seed (see {}); pass another --out, \
+                "{} holds results of other policies, another seed or another operator (see {}); pass another --out, \
                  or delete it to start again",
                 csv.display(),
                 sidecar.display()

@@ -1,6 +1,9 @@
 //! The exact distance table: a breadth-first search of all 3,674,160 positions in the
 //! quarter-turn metric. With it an optimal solution is a greedy descent, every optimal
-//! solution can be listed, and positions can be drawn at an exact move distance.
+//! solution can be listed or the cheapest picked under a price per move, and positions can be
+//! drawn at an exact move distance.
+
+use std::collections::HashMap;
 
 use crate::Solver;
 use crate::coord::{CoordMoves, Metric, histogram};
@@ -60,6 +63,61 @@ impl DistanceTable {
         let mut path = Vec::new();
         self.descend_all(position.index(), &mut path, &mut solutions);
         solutions
+    }
+
+    /// The optimal solution that costs least when each move has a price, which may depend on
+    /// the move before it (`None` for the first). A hand, say, turns U' in one action but U in
+    /// three, and needs no re-posing for a second move on the same face. Ties go to the
+    /// solution listed first by `all_optimal`.
+    pub fn cheapest_optimal(
+        &self,
+        position: &Position,
+        cost: impl Fn(Option<Move>, Move) -> u32,
+    ) -> Vec<Move> {
+        let mut memo = HashMap::new();
+        let (mut index, mut before) = (position.index(), None);
+        let mut solution = Vec::with_capacity(self.distances[index] as usize);
+        while self.distances[index] > 0 {
+            let (_, m) = self.cheapest_from(index, before, &cost, &mut memo);
+            solution.push(self.moves.moves()[m]);
+            index = self.moves.index_after(index, m);
+            before = Some(m);
+        }
+        solution
+    }
+
+    /// (least cost from `index` to solved, the first move's number), `before` being the number
+    /// of the move that led here.
+    fn cheapest_from(
+        &self,
+        index: usize,
+        before: Option<usize>,
+        cost: &dyn Fn(Option<Move>, Move) -> u32,
+        memo: &mut HashMap<(usize, Option<usize>), (u32, usize)>,
+    ) -> (u32, usize) {
+        if let Some(&known) = memo.get(&(index, before)) {
+            return known;
+        }
+        let moves = self.moves.moves();
+        let here = self.distances[index];
+        let mut best = (u32::MAX, usize::MAX);
+        for m in 0..moves.len() {
+            let next = self.moves.index_after(index, m);
+            if self.distances[next] + 1 != here {
+                continue;
+            }
+            let rest = if here == 1 {
+                0
+            } else {
+                self.cheapest_from(next, Some(m), cost, memo).0
+            };
+            let total = cost(before.map(|b| moves[b]), moves[m]).saturating_add(rest);
+            if total < best.0 {
+                best = (total, m);
+            }
+        }
+        memo.insert((index, before), best);
+        best
     }
 
     fn descend_all(&self, index: usize, path: &mut Vec<Move>, out: &mut Vec<Vec<Move>>) {

@@ -95,6 +95,46 @@ fn all_optimal_solutions_are_distinct_optimal_and_complete() {
     }
 }
 
+#[test]
+fn the_cheapest_optimal_solution_is_the_least_costly_of_all_optimal_ones() {
+    // A hand's price: a clockwise quarter turn is three counter-clockwise ones, and a move
+    // on another face than the last one needs the cube re-posed first.
+    let price = |before: Option<Move>, m: Move| {
+        let turns = if m.quarters == 3 { 1 } else { 3 };
+        turns + u32::from(before.is_none_or(|b| b.face != m.face))
+    };
+    let total = |solution: &[Move]| {
+        (0..solution.len())
+            .map(|i| price(i.checked_sub(1).map(|j| solution[j]), solution[i]))
+            .sum::<u32>()
+    };
+    let u2 = Facelets::SOLVED.apply_all(&parse_moves("U2").unwrap());
+    let cheapest = table().cheapest_optimal(&Position::of(&u2), price);
+    assert_eq!(dexcube_cube::format_moves(&cheapest), "U' U'");
+    assert!(
+        table()
+            .cheapest_optimal(&Position::SOLVED, price)
+            .is_empty()
+    );
+    let mut saved = 0;
+    for index in (0..POSITIONS).step_by(104_729) {
+        let position = Position::from_index(index);
+        let all = table().all_optimal(&position);
+        let cheapest = table().cheapest_optimal(&position, price);
+        assert!(all.contains(&cheapest), "optimal");
+        assert_eq!(
+            total(&cheapest),
+            all.iter().map(|s| total(s)).min().unwrap(),
+            "least costly"
+        );
+        saved += total(&table().solve(&position)) - total(&cheapest);
+    }
+    assert!(
+        saved > 0,
+        "the first optimal solution is often not the cheapest"
+    );
+}
+
 /// Whole-cube turns, each made of two opposite face turns.
 const ROTATIONS: [&str; 3] = ["R L'", "U D'", "F B'"];
 

@@ -131,7 +131,7 @@ pub fn run_cube(
     stages: &mut LoadedStages,
     scene: &std::sync::Arc<Scene>,
     table: &DistanceTable,
-    (scramble, rollback, seed): (&[Move], bool, u64),
+    (scramble, config, seed): (&[Move], OperatorConfig, u64),
     hooks: Hooks,
 ) -> crate::Outcome {
     let mut sim = Sim::new(scene.clone());
@@ -139,10 +139,7 @@ pub fn run_cube(
     set_up_scramble(&mut sim, scramble, resting);
     let accepts = pose_reached(stages.rot_mode);
     let mut operator = Operator {
-        config: OperatorConfig {
-            rollback,
-            ..OperatorConfig::default()
-        },
+        config,
         stage1: &mut stages.stage1,
         stage1_accepts: &accepts,
         stage2: &mut stages.stage2,

@@ -10,4 +10,6 @@ pub mod eval;
 pub mod operator;
 pub mod stages;
 
-pub use operator::{Event, Failure, Operator, OperatorConfig, Outcome, move_plan, set_up_scramble};
+pub use operator::{
+    Event, Failure, Operator, OperatorConfig, Outcome, hand_cost, move_plan, set_up_scramble,
+};

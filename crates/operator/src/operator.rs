@@ -14,6 +14,11 @@
 //!
 //! Without rollback the plan runs open loop. Action number (AN) counts atomic actions, Stage 1
 //! and Stage 2 runs alike; randomisations are counted apart.
+//!
+//! By default the operator plans for the hand: of the optimal plans it takes the one with the
+//! fewest atomic actions (`hand_cost`: U' is one Stage 2 run, U three), and it skips Stage 1
+//! when the face to turn is already up. `OperatorConfig::plan_for_hand` off gives the paper's
+//! operator: the first optimal plan, and Stage 1 before every move.
 
 use dexcube_cube::{DistanceTable, Face, Facelets, Move, Position, Solver};
 use dexcube_sim::cube::{CubeState, snap_layers};
@@ -77,6 +82,8 @@ pub enum Event {
         attempt: usize,
         ok: bool,
     },
+    /// The face the move needs is already up: no Stage 1.
+    AlreadyUp(Face),
     Stage2 {
         turn: usize,
         of: usize,
@@ -100,6 +107,9 @@ pub struct OperatorConfig {
     pub stage1_attempts: usize,
     /// Restores of a misaligned cube per move before giving up.
     pub restores: usize,
+    /// Plan for the hand: the optimal plan of fewest actions, and no Stage 1 for a face that
+    /// is already up. Off: the paper's operator.
+    pub plan_for_hand: bool,
 }
 
 impl Default for OperatorConfig {
@@ -109,6 +119,7 @@ impl Default for OperatorConfig {
             max_actions: 100,
             stage1_attempts: 3,
             restores: 2,
+            plan_for_hand: true,
         }
     }
 }
@@ -125,6 +136,14 @@ pub fn move_plan(m: Move) -> (Face, usize) {
     };
     // One U' on top is U', R' or B' (= F'); three make U, R or F.
     (up, if m.quarters == 3 { 1 } else { 3 })
+}
+
+/// Atomic actions a move costs the hand: a Stage 1, unless the move before it needed the same
+/// face up, and one or three Stage 2 turns.
+pub fn hand_cost(before: Option<Move>, m: Move) -> u32 {
+    let (up, turns) = move_plan(m);
+    let stage1 = before.is_none_or(|b| move_plan(b).0 != up);
+    (turns + usize::from(stage1)) as u32
 }
 
 /// The rollback's test of the cube's pose after Stage 1: (simulation, target position, target
@@ -151,7 +170,7 @@ impl Operator<'_> {
             outcome.failure = Some(Failure::StuckMisaligned);
             return outcome;
         };
-        let mut plan = self.table.solve(&Position::of(&start));
+        let mut plan = self.plan(&start);
         narrate(&Event::Plan(plan.clone()));
         let mut expected = start;
         while let Some(&m) = plan.first() {
@@ -175,7 +194,7 @@ impl Operator<'_> {
                     narrate(&Event::MoveDone(m))
                 }
                 Some(seen) => {
-                    plan = self.table.solve(&Position::of(&seen));
+                    plan = self.plan(&seen);
                     expected = seen;
                     outcome.replans += 1;
                     narrate(&Event::Replan(plan.clone()));
@@ -200,6 +219,16 @@ impl Operator<'_> {
         outcome
     }
 
+    /// An optimal plan from `cube`: the hand's cheapest, or the solver's first.
+    fn plan(&self, cube: &Facelets) -> Vec<Move> {
+        let position = Position::of(cube);
+        if self.config.plan_for_hand {
+            self.table.cheapest_optimal(&position, hand_cost)
+        } else {
+            self.table.solve(&position)
+        }
+    }
+
     /// Both stages of one move, with the rollback checks; a failure ends the attempt.
     fn execute(
         &mut self,
@@ -210,7 +239,12 @@ impl Operator<'_> {
     ) -> Option<Failure> {
         let (up, turns) = move_plan(m);
         let target = stage1_target(up);
-        for attempt in 1..=self.config.stage1_attempts {
+        let already_up =
+            self.config.plan_for_hand && (self.stage1_accepts)(sim, self.resting, target);
+        if already_up {
+            narrate(&Event::AlreadyUp(up));
+        }
+        for attempt in (1..=self.config.stage1_attempts).filter(|_| !already_up) {
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
             if let Some(failure) = outcome.count(&run) {
                 narrate(&Event::Ended { stage: 1, failure });

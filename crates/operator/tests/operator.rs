@@ -2,12 +2,15 @@
 //! policies: planning, move mapping, readout and completion solve the cube, and each rollback
 //! branch fires on the situation it is for.
 
+use dexcube_cube::Face;
 use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::RotMode;
 use dexcube_operator::stages::{
     KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached, randomise_pose,
 };
-use dexcube_operator::{Failure, Operator, OperatorConfig, Outcome, move_plan, set_up_scramble};
+use dexcube_operator::{
+    Failure, Operator, OperatorConfig, Outcome, hand_cost, move_plan, set_up_scramble,
+};
 use dexcube_sim::cube::{CubeState, snap_layers};
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{Scene, SceneKind, Sim};
@@ -24,15 +27,19 @@ fn attempt(
     distance: usize,
     seed: u64,
 ) -> Outcome {
-    attempt_judged(RotMode::Axis, stage1, stage2, rollback, distance, seed)
+    let config = OperatorConfig {
+        rollback,
+        ..OperatorConfig::default()
+    };
+    attempt_judged(RotMode::Axis, config, stage1, stage2, distance, seed)
 }
 
-/// `attempt`, with Stage 1's pose judged in `mode`.
+/// `attempt`, with Stage 1's pose judged in `mode` and the operator configured by `config`.
 fn attempt_judged(
     mode: RotMode,
+    config: OperatorConfig,
     stage1: &mut dyn Stage1,
     stage2: &mut dyn Stage2,
-    rollback: bool,
     distance: usize,
     seed: u64,
 ) -> Outcome {
@@ -42,10 +49,7 @@ fn attempt_judged(
     set_up_scramble(&mut sim, &scramble.moves, RESTING);
     let accepts = pose_reached(mode);
     let mut operator = Operator {
-        config: OperatorConfig {
-            rollback,
-            ..OperatorConfig::default()
-        },
+        config,
         stage1,
         stage1_accepts: &accepts,
         stage2,
@@ -57,28 +61,50 @@ fn attempt_judged(
     operator.solve(&mut sim, &mut |_| {})
 }
 
+/// The paper's operator runs Stage 1 and then 1 or 3 Stage 2 runs for each move of the
+/// solver's first optimal plan. Planning for the hand takes the optimal plan of fewest actions
+/// and runs no Stage 1 for a face already up (U, at the start), and needs fewer actions.
 #[test]
 fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
     let table = DistanceTable::build();
-    for (distance, seed) in [(1, 0), (4, 1), (9, 2), (14, 3)] {
-        let outcome = attempt(
-            &mut KinematicStage1,
-            &mut KinematicStage2 { angle: U_PRIME },
-            true,
-            distance,
-            seed,
-        );
-        assert!(outcome.solved, "distance {distance}: {outcome:?}");
-        let plan = table.solve(&dexcube_cube::Position::of(
+    let mut actions = [0, 0];
+    for (distance, seed) in [(1, 0), (2, 5), (4, 1), (9, 2), (14, 3)] {
+        let position = dexcube_cube::Position::of(
             &scrambles_at_distance(&table, distance, 1, seed)[0].facelets,
-        ));
-        let expected: usize = plan.iter().map(|&m| 1 + move_plan(m).1).sum();
-        assert_eq!(
-            outcome.actions, expected,
-            "one Stage 1 and 1 or 3 Stage 2 runs per move"
         );
-        assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
+        for plan_for_hand in [false, true] {
+            let config = OperatorConfig {
+                plan_for_hand,
+                ..OperatorConfig::default()
+            };
+            let outcome = attempt_judged(
+                RotMode::Axis,
+                config,
+                &mut KinematicStage1,
+                &mut KinematicStage2 { angle: U_PRIME },
+                distance,
+                seed,
+            );
+            assert!(outcome.solved, "distance {distance}: {outcome:?}");
+            assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
+            let expected: usize = if plan_for_hand {
+                let plan = table.cheapest_optimal(&position, hand_cost);
+                let priced: u32 = (0..plan.len())
+                    .map(|i| hand_cost(i.checked_sub(1).map(|j| plan[j]), plan[i]))
+                    .sum();
+                priced as usize - usize::from(move_plan(plan[0]).0 == Face::U)
+            } else {
+                let plan = table.solve(&position);
+                plan.iter().map(|&m| 1 + move_plan(m).1).sum()
+            };
+            assert_eq!(outcome.actions, expected, "distance {distance}, {config:?}");
+            actions[usize::from(plan_for_hand)] += outcome.actions;
+        }
     }
+    assert!(
+        actions[1] < actions[0],
+        "planning for the hand saves actions: {actions:?}"
+    );
 }
 
 /// A Stage 1 that leaves the cube upside down on its first `misses` runs.
@@ -200,9 +226,9 @@ fn the_opposite_face_up_makes_the_same_move_so_pair_mode_accepts_it() {
         );
         let flipped = attempt_judged(
             RotMode::Pair,
+            OperatorConfig::default(),
             &mut UpsideDownStage1,
             &mut KinematicStage2 { angle: U_PRIME },
-            true,
             distance,
             seed,
         );
