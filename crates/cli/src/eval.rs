@@ -190,7 +190,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         }
     }
     let command = format!(
-        "dexcube eval --per-distance {} --distances {} --seed {}{} --rot-policy {} --layer-policy {}",
+        "dexcube eval --per-distance {} --distances {} --seed {}{}{} --rot-policy {} --layer-policy {}",
         args.per_distance,
         args.distances,
         args.seed,
@@ -198,6 +198,11 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
             " --no-rollback"
         } else if args.rollback_only {
             " --rollback-only"
+        } else {
+            ""
+        },
+        if args.operator.paper_operator {
+            " --paper-operator"
         } else {
             ""
         },
