@@ -141,8 +141,9 @@ fn demo_narrates_the_hand_solving_with_the_shipped_policies() {
     );
     let out = stdout(&o);
     assert!(out.contains("Optimal plan, 1 quarter turns"), "{out}");
+    // Stage 1 either brings the face up or, when it already is, says it is not needed.
     assert!(
-        out.contains("Stage 1: bring") && out.contains("Stage 2: U' on the top layer"),
+        out.contains("Stage 1: ") && out.contains("Stage 2: U' on the top layer"),
         "{out}"
     );
     let last = out.lines().rev().nth(1).unwrap_or("");
@@ -207,11 +208,11 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
         .map(|&a| if a == "5" { "6" } else { a })
         .collect();
     let refused = dexcube(&other_seed, "");
-    assert_clean_failure(
-        &refused,
-        2,
-        "holds results of other policies or another seed",
-    );
+    assert_clean_failure(&refused, 2, "holds results of other policies, another seed");
+    // So would continuing it with the paper's operator.
+    let paper_operator = [&args[..], &["--paper-operator"]].concat();
+    let refused = dexcube(&paper_operator, "");
+    assert_clean_failure(&refused, 2, "or another operator");
 }
 
 #[test]
