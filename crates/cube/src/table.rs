@@ -95,22 +95,16 @@ impl DistanceTable {
         cost: &dyn Fn(Option<Move>, Move) -> u32,
         memo: &mut HashMap<(usize, Option<usize>), (u32, usize)>,
     ) -> (u32, usize) {
+        if self.distances[index] == 0 {
+            return (0, usize::MAX);
+        }
         if let Some(&known) = memo.get(&(index, before)) {
             return known;
         }
         let moves = self.moves.moves();
-        let here = self.distances[index];
         let mut best = (u32::MAX, usize::MAX);
-        for m in 0..moves.len() {
-            let next = self.moves.index_after(index, m);
-            if self.distances[next] + 1 != here {
-                continue;
-            }
-            let rest = if here == 1 {
-                0
-            } else {
-                self.cheapest_from(next, Some(m), cost, memo).0
-            };
+        for (m, next) in self.closer(index) {
+            let rest = self.cheapest_from(next, Some(m), cost, memo).0;
             let total = cost(before.map(|b| moves[b]), moves[m]).saturating_add(rest);
             if total < best.0 {
                 best = (total, m);
@@ -120,19 +114,24 @@ impl DistanceTable {
         best
     }
 
-    fn descend_all(&self, index: usize, path: &mut Vec<Move>, out: &mut Vec<Vec<Move>>) {
+    /// The moves (by number) that bring position `index` one step closer to solved, each with
+    /// the position it leads to, in move order.
+    fn closer(&self, index: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
         let here = self.distances[index];
-        if here == 0 {
+        (0..self.moves.moves().len())
+            .map(move |m| (m, self.moves.index_after(index, m)))
+            .filter(move |&(_, next)| self.distances[next] + 1 == here)
+    }
+
+    fn descend_all(&self, index: usize, path: &mut Vec<Move>, out: &mut Vec<Vec<Move>>) {
+        if self.distances[index] == 0 {
             out.push(path.clone());
             return;
         }
-        for (m, &mv) in self.moves.moves().iter().enumerate() {
-            let next = self.moves.index_after(index, m);
-            if self.distances[next] + 1 == here {
-                path.push(mv);
-                self.descend_all(next, path, out);
-                path.pop();
-            }
+        for (m, next) in self.closer(index) {
+            path.push(self.moves.moves()[m]);
+            self.descend_all(next, path, out);
+            path.pop();
         }
     }
 }
@@ -143,12 +142,12 @@ impl Solver for DistanceTable {
         let mut index = position.index();
         let mut solution = Vec::with_capacity(self.distances[index] as usize);
         while self.distances[index] > 0 {
-            let here = self.distances[index];
-            let m = (0..self.moves.moves().len())
-                .find(|&m| self.distances[self.moves.index_after(index, m)] + 1 == here)
+            let (m, next) = self
+                .closer(index)
+                .next()
                 .expect("every position but solved has a neighbour one step closer");
             solution.push(self.moves.moves()[m]);
-            index = self.moves.index_after(index, m);
+            index = next;
         }
         solution
     }

@@ -239,12 +239,12 @@ impl Operator<'_> {
     ) -> Option<Failure> {
         let (up, turns) = move_plan(m);
         let target = stage1_target(up);
-        let already_up =
-            self.config.plan_for_hand && (self.stage1_accepts)(sim, self.resting, target);
-        if already_up {
+        let mut stage1_attempts = self.config.stage1_attempts;
+        if self.config.plan_for_hand && (self.stage1_accepts)(sim, self.resting, target) {
             narrate(&Event::AlreadyUp(up));
+            stage1_attempts = 0;
         }
-        for attempt in (1..=self.config.stage1_attempts).filter(|_| !already_up) {
+        for attempt in 1..=stage1_attempts {
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
             if let Some(failure) = outcome.count(&run) {
                 narrate(&Event::Ended { stage: 1, failure });
@@ -257,7 +257,7 @@ impl Operator<'_> {
                 attempt,
                 ok,
             });
-            if ok || !self.config.rollback || attempt == self.config.stage1_attempts {
+            if ok || !self.config.rollback || attempt == stage1_attempts {
                 break;
             }
             randomise_pose(sim, self.resting, &mut self.rng);
