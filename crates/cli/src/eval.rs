@@ -19,6 +19,7 @@ use dexcube_operator::OperatorConfig;
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
+use dexcube_operator::stages::Driving;
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_sim::{Scene, SceneKind};
@@ -29,29 +30,91 @@ use crate::env::{EnvKind, original_object, suited};
 /// Which operator runs the plan.
 #[derive(Args, Clone, Copy)]
 pub struct OperatorArgs {
-    /// The paper's operator: the solver's first optimal plan, and Stage 1 before every move.
-    /// By default the operator plans for the hand: of the optimal plans, the one of fewest
-    /// atomic actions, and no Stage 1 when the face to turn is already up.
+    /// The paper's operator: the solver's first optimal plan, Stage 1 before every move, and
+    /// each stage for its policy's whole episode. By default the operator plans for the hand:
+    /// of the optimal plans, the one of fewest atomic actions; no Stage 1 when the face to
+    /// turn is already up; Stage 1 ends once the pose has been held 5 steps; and the hand
+    /// opens gradually from where the last stage left it.
     #[arg(long)]
     pub paper_operator: bool,
+    /// End Stage 1 once the pose has been held for this many control steps (its success test
+    /// passing at each); 0 runs the policy's whole 100-step episode. Default: 5 planning for
+    /// the hand, 0 with --paper-operator.
+    #[arg(long, value_name = "STEPS", value_parser = clap::value_parser!(u64).range(0..=100))]
+    pub stage1_held: Option<u64>,
+    /// How the hand opens before each stage, from where the last one left it. Default:
+    /// gradual planning for the hand, at-once with --paper-operator.
+    #[arg(long, value_enum)]
+    pub opening: Option<Opening>,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+pub enum Opening {
+    /// The targets jump to the flat hand.
+    AtOnce,
+    /// The targets move to the flat hand step by step over the settling steps.
+    Gradual,
 }
 
 impl OperatorArgs {
     pub fn config(self, rollback: bool) -> OperatorConfig {
+        let mut driving = if self.paper_operator {
+            Driving::default()
+        } else {
+            Driving::FOR_HAND
+        };
+        if let Some(steps) = self.stage1_held {
+            driving.stage1_held_steps = (steps > 0).then_some(steps as usize);
+        }
+        if let Some(opening) = self.opening {
+            driving.gradual_opening = opening == Opening::Gradual;
+        }
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
+            driving,
             ..OperatorConfig::default()
         }
     }
 
     /// The operator's name in a run's record.
-    fn name(self) -> &'static str {
-        if self.paper_operator {
-            "paper"
+    fn name(self) -> String {
+        let driving = self.config(true).driving;
+        let mut name = if self.paper_operator {
+            "paper".to_string()
         } else {
-            "planning for the hand"
+            "planning for the hand".to_string()
+        };
+        if driving.gradual_opening {
+            name += ", opening the hand gradually";
+        } else if self.opening.is_some() || !self.paper_operator {
+            name += ", opening the hand at once";
         }
+        if !self.paper_operator || self.stage1_held.is_some() {
+            match driving.stage1_held_steps {
+                Some(steps) => name += &format!(", Stage 1 ends once held {steps} steps"),
+                None => name += ", whole Stage 1 episodes",
+            }
+        }
+        name
+    }
+
+    /// The flags that select this operator, as a command line names them.
+    fn flags(self) -> String {
+        let paper = if self.paper_operator {
+            " --paper-operator"
+        } else {
+            ""
+        };
+        let held = self
+            .stage1_held
+            .map_or(String::new(), |steps| format!(" --stage1-held {steps}"));
+        let opening = match self.opening {
+            Some(Opening::AtOnce) => " --opening at-once",
+            Some(Opening::Gradual) => " --opening gradual",
+            None => "",
+        };
+        format!("{paper}{held}{opening}")
     }
 }
 
@@ -201,11 +264,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         } else {
             ""
         },
-        if args.operator.paper_operator {
-            " --paper-operator"
-        } else {
-            ""
-        },
+        args.operator.flags(),
         files.rot.display(),
         files.layer.display()
     );
@@ -261,7 +320,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 randomisations: outcome.randomisations,
                 replans: outcome.replans,
                 control_steps: outcome.control_steps,
-                failure: outcome.failure.map_or(String::new(), |f| format!("{f:?}")),
+                failure: outcome.failure_text(),
             };
             let mut all = shared.lock().expect("lock");
             all.push(row);
@@ -454,18 +513,37 @@ impl Ending {
     }
 }
 
-/// Runs a deterministic episode and returns its last step's info, and whether the object
-/// ended square (a physical cube in its good state; any other object always).
-fn episode(env: &mut dyn SimulatedEnv, policy: &Policy, seed: u64) -> (Info, bool) {
+/// One deterministic episode of an atomic action: its last step's info, whether the object
+/// ended square (a physical cube in its good state; any other object always), and the
+/// longest run of consecutive steps at the goal before the end (or before a drop).
+struct EpisodeTrace {
+    info: Info,
+    square: bool,
+    longest_hold: usize,
+}
+
+/// Runs a deterministic episode from `seed`.
+fn episode(env: &mut dyn SimulatedEnv, policy: &Policy, seed: u64) -> EpisodeTrace {
     let (mut obs, _) = env.reset(Some(seed));
+    let (mut hold, mut longest_hold) = (0, 0);
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
+        hold = if t.info.is_success { hold + 1 } else { 0 };
+        longest_hold = longest_hold.max(hold);
         if t.terminated || t.truncated {
-            return (t.info, is_square(env.sim()));
+            return EpisodeTrace {
+                square: is_square(env.sim()),
+                info: t.info,
+                longest_hold,
+            };
         }
         obs = t.observation;
     }
 }
+
+/// Holds of at least this many control steps are counted in `eval-stage`'s report: what a
+/// stage that stopped once its goal had been held that long would have scored.
+const HOLDS: [usize; 3] = [1, 10, 25];
 
 pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let files = args.policies.files()?;
@@ -474,6 +552,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         EnvKind::Layer => files.layer.clone(),
     };
     let endings: [AtomicUsize; 7] = Default::default();
+    let held: [AtomicUsize; HOLDS.len()] = Default::default();
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
         EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
@@ -502,9 +581,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             Ok((policy, env))
         },
         |(policy, env), k| {
-            let (info, square) = episode(env.as_mut(), policy, args.seed + k as u64);
-            endings[Ending::of(&info, thresholds, args.stage == EnvKind::Layer, square) as usize]
+            let trace = episode(env.as_mut(), policy, args.seed + k as u64);
+            let turning = args.stage == EnvKind::Layer;
+            endings[Ending::of(&trace.info, thresholds, turning, trace.square) as usize]
                 .fetch_add(1, Ordering::Relaxed);
+            for (count, steps) in held.iter().zip(HOLDS) {
+                if trace.longest_hold >= steps {
+                    count.fetch_add(1, Ordering::Relaxed);
+                }
+            }
             bar.inc(1);
             Ok(())
         },
@@ -539,6 +624,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         if n > 0 {
             println!("  {}: {n}", ending.name());
         }
+    }
+    for (count, steps) in held.iter().zip(HOLDS) {
+        println!(
+            "  at the goal for {steps} step(s) running at some point: {}",
+            count.load(Ordering::Relaxed)
+        );
     }
     if args.record {
         record(&prefix, &args, (object, object == trained), wins, (lo, hi))?;

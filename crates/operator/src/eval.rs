@@ -15,7 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::operator::{Operator, OperatorConfig, set_up_scramble};
-use crate::stages::{PolicyStage1, PolicyStage2, pose_reached};
+use crate::stages::{Driving, PolicyStage1, PolicyStage2, pose_reached};
 
 /// The paper's Table I, move distances 1 to 14.
 pub const PAPER_SR_ROLLBACK: [f64; 14] = [
@@ -56,10 +56,12 @@ impl PolicyFiles {
             stage1: PolicyStage1 {
                 policy: Policy::load(&self.rot, &device)?,
                 mode: self.rot_mode,
+                driving: Driving::default(),
             },
             stage2: PolicyStage2 {
                 policy: Policy::load(&self.layer, &device)?,
                 resting_z: resting[2],
+                driving: Driving::default(),
             },
             rot_mode: self.rot_mode,
             resting,
@@ -138,6 +140,8 @@ pub fn run_cube(
     let resting = stages.resting;
     set_up_scramble(&mut sim, scramble, resting);
     let accepts = pose_reached(stages.rot_mode);
+    stages.stage1.driving = config.driving;
+    stages.stage2.driving = config.driving;
     let mut operator = Operator {
         config,
         stage1: &mut stages.stage1,

@@ -26,7 +26,7 @@ use dexcube_sim::{Pose, Sim};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::stages::{Stage1, Stage2, StageRun, face_up, randomise_pose, stage1_target};
+use crate::stages::{Driving, Stage1, Stage2, StageRun, face_up, randomise_pose, stage1_target};
 
 /// Why an attempt ended without a solved cube.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -53,19 +53,38 @@ pub struct Outcome {
     pub randomisations: usize,
     pub replans: usize,
     pub control_steps: usize,
+    /// The stage (1 or 2) that dropped the cube or blew up the physics, and at which of its
+    /// control steps (counting the hand's settling steps before the policy acts).
+    pub failed_at: Option<(usize, usize)>,
 }
 
 impl Outcome {
-    /// Counts one atomic action; a dropped cube or a blow-up ends the attempt.
-    fn count(&mut self, run: &StageRun) -> Option<Failure> {
+    /// Counts one atomic action of `stage`; a dropped cube or a blow-up ends the attempt.
+    fn count(&mut self, stage: usize, run: &StageRun) -> Option<Failure> {
         self.actions += 1;
         self.control_steps += run.steps;
-        if run.dropped {
+        let failure = if run.dropped {
             Some(Failure::Dropped)
         } else if run.diverged {
             Some(Failure::Diverged)
         } else {
             None
+        };
+        if failure.is_some() {
+            self.failed_at = Some((stage, run.steps));
+        }
+        failure
+    }
+
+    /// Why the attempt failed, and where if a stage ended it ("Dropped in Stage 1 at step
+    /// 14"); empty if it did not fail.
+    pub fn failure_text(&self) -> String {
+        match (self.failure, self.failed_at) {
+            (Some(failure), Some((stage, step))) => {
+                format!("{failure:?} in Stage {stage} at step {step}")
+            }
+            (Some(failure), None) => format!("{failure:?}"),
+            (None, _) => String::new(),
         }
     }
 }
@@ -110,6 +129,8 @@ pub struct OperatorConfig {
     /// Plan for the hand: the optimal plan of fewest actions, and no Stage 1 for a face that
     /// is already up. Off: the paper's operator.
     pub plan_for_hand: bool,
+    /// How the policies are run on the cube.
+    pub driving: Driving,
 }
 
 impl Default for OperatorConfig {
@@ -120,6 +141,7 @@ impl Default for OperatorConfig {
             stage1_attempts: 3,
             restores: 2,
             plan_for_hand: true,
+            driving: Driving::FOR_HAND,
         }
     }
 }
@@ -246,7 +268,7 @@ impl Operator<'_> {
         }
         for attempt in 1..=stage1_attempts {
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
-            if let Some(failure) = outcome.count(&run) {
+            if let Some(failure) = outcome.count(1, &run) {
                 narrate(&Event::Ended { stage: 1, failure });
                 return Some(failure);
             }
@@ -268,7 +290,7 @@ impl Operator<'_> {
         }
         for turn in 1..=turns {
             let run = self.stage2.run(sim, &mut *self.watch);
-            let failure = outcome.count(&run);
+            let failure = outcome.count(2, &run);
             narrate(&Event::Stage2 { turn, of: turns });
             if let Some(failure) = failure {
                 narrate(&Event::Ended { stage: 2, failure });

@@ -52,41 +52,94 @@ pub struct StageRun {
     pub diverged: bool,
 }
 
-/// Runs a policy for a whole episode, as its training and `eval-stage` do: the policies learn
-/// to reach their goal by the episode's last step and hold it there, so the operator judges
-/// the stage at the end, not at the first step the goal is met (a cube caught mid-turn and
-/// then let go was dropped half again as often). First the hand opens flat (the model's zero
-/// pose) and then takes the neutral action, `SETTLE_STEPS` each, with the cube on its palm:
-/// every training episode starts that way, from a hand placed flat and left to settle, while
-/// the previous stage leaves the fingers wherever it ended (the paper's "problematic end
-/// states"). Going straight to the neutral action from such an end state throws the cube off
-/// the palm. These steps count as control steps, not as an action.
+/// How the operator runs the policies on the physical cube, beyond the policies themselves.
+/// The paper's operator (`Driving::default()`) opens the hand at once and runs each stage for
+/// the policy's whole episode; the operator planning for the hand does neither
+/// (`Driving::FOR_HAND`): both were measured in the operator (`results/TRAINING.md`,
+/// session 6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Driving {
+    /// Open the hand from where the last stage left it by moving its targets to the flat
+    /// hand step by step over the first settling steps, rather than at once.
+    pub gradual_opening: bool,
+    /// End Stage 1 once its pose test has passed for this many control steps running,
+    /// rather than after the policy's whole episode.
+    pub stage1_held_steps: Option<usize>,
+}
+
+impl Driving {
+    pub const FOR_HAND: Driving = Driving {
+        gradual_opening: true,
+        stage1_held_steps: Some(5),
+    };
+}
+
+/// Runs a policy for its episode, as its training and `eval-stage` do: the policies learn to
+/// reach their goal by the episode's last step and hold it there. The stage is judged at its
+/// end, and `stop` may end it sooner: it is asked after every step. (Ending at the first step
+/// the goal is met let go of cubes caught mid-turn: they dropped half again as often.)
+///
+/// First the hand opens flat (the model's zero pose) and then takes the neutral action,
+/// `SETTLE_STEPS` each, with the cube on its palm: every training episode starts that way,
+/// from a hand placed flat and left to settle, while the previous stage leaves the fingers
+/// wherever it ended (the paper's "problematic end states"). Going straight to the neutral
+/// action from such an end state throws the cube off the palm; opening at once still does
+/// now and then, which `gradual_opening` avoids. These steps count as control steps, not as
+/// an action.
 fn drive(
     sim: &mut Sim,
     act: impl FnMut(&Sim) -> Vec<f64>,
     resting_z: f64,
+    gradual_opening: bool,
+    stop: &mut dyn FnMut(&Sim) -> bool,
     watch: Watch,
 ) -> StageRun {
     let mut run = StageRun::default();
-    let open = sim.scene().open_hand_action().to_vec();
-    for relax in [open, vec![0.0; HAND_ACTUATORS]] {
-        let hold = |_: &Sim| relax.clone();
-        if !advance(sim, hold, SETTLE_STEPS, resting_z, watch, &mut run) {
-            return run;
-        }
+    let open = sim.scene().open_hand_action();
+    let from = if gradual_opening { sim.action() } else { open };
+    let mut step = 0;
+    let opening = |_: &Sim| {
+        step += 1;
+        let t = step as f64 / SETTLE_STEPS as f64;
+        from.iter()
+            .zip(&open)
+            .map(|(a, b)| a + t * (b - a))
+            .collect()
+    };
+    let neutral = |_: &Sim| vec![0.0; HAND_ACTUATORS];
+    let never = &mut |_: &Sim| false;
+    if !advance(
+        sim,
+        opening,
+        SETTLE_STEPS,
+        resting_z,
+        watch,
+        never,
+        &mut run,
+    ) || !advance(
+        sim,
+        neutral,
+        SETTLE_STEPS,
+        resting_z,
+        watch,
+        never,
+        &mut run,
+    ) {
+        return run;
     }
-    advance(sim, act, EPISODE_STEPS, resting_z, watch, &mut run);
+    advance(sim, act, EPISODE_STEPS, resting_z, watch, stop, &mut run);
     run
 }
 
-/// `steps` control steps of `act`; false if the cube dropped or the physics blew up (noted in
-/// `run`).
+/// Up to `steps` control steps of `act`, ending early once `stop` says so; false if the cube
+/// dropped or the physics blew up (noted in `run`).
 fn advance(
     sim: &mut Sim,
     mut act: impl FnMut(&Sim) -> Vec<f64>,
     steps: usize,
     resting_z: f64,
     watch: Watch,
+    stop: &mut dyn FnMut(&Sim) -> bool,
     run: &mut StageRun,
 ) -> bool {
     for _ in 0..steps {
@@ -106,6 +159,9 @@ fn advance(
             run.dropped = true;
             return false;
         }
+        if stop(sim) {
+            break;
+        }
     }
     true
 }
@@ -114,16 +170,31 @@ fn advance(
 pub struct PolicyStage1 {
     pub policy: Policy,
     pub mode: RotMode,
+    pub driving: Driving,
 }
 
 impl Stage1 for PolicyStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
         let goal = pose_goal(position, target);
         let policy = &self.policy;
+        let reached = pose_reached(self.mode);
+        let mut running = 0;
+        let mut held = |sim: &Sim| {
+            self.driving.stage1_held_steps.is_some_and(|steps| {
+                running = if reached(sim, position, target) {
+                    running + 1
+                } else {
+                    0
+                };
+                running >= steps
+            })
+        };
         drive(
             sim,
             |sim| policy.act(&base_observation(sim), &goal),
             position[2],
+            self.driving.gradual_opening,
+            &mut held,
             watch,
         )
     }
@@ -134,6 +205,7 @@ impl Stage1 for PolicyStage1 {
 pub struct PolicyStage2 {
     pub policy: Policy,
     pub resting_z: f64,
+    pub driving: Driving,
 }
 
 /// The cube-frame face whose outward normal points most nearly up in the world.
@@ -154,6 +226,8 @@ impl Stage2 for PolicyStage2 {
             sim,
             |sim| policy.act(&view.observe(sim), &goal),
             self.resting_z,
+            self.driving.gradual_opening,
+            &mut |_| false,
             watch,
         )
     }

@@ -6,7 +6,8 @@ use dexcube_cube::Face;
 use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::RotMode;
 use dexcube_operator::stages::{
-    KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached, randomise_pose,
+    Driving, KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached,
+    randomise_pose,
 };
 use dexcube_operator::{
     Failure, Operator, OperatorConfig, Outcome, hand_cost, move_plan, set_up_scramble,
@@ -290,4 +291,87 @@ fn randomising_the_pose_seats_the_cube_on_the_palm_and_keeps_the_layers() {
             "the layers are as they were"
         );
     }
+}
+
+/// A policy's Stage 1 told to end once the pose is held stops as soon as its test has passed
+/// for that many steps running: here the cube starts at rest with U up, the target.
+/// Without it the stage runs the policy's whole episode.
+#[test]
+fn a_held_pose_ends_policy_stage_1_early() {
+    let (mut stages, resting) = shipped_stages();
+    let target = dexcube_operator::stages::stage1_target(Face::U);
+    let accepts = pose_reached(RotMode::Pair);
+    let settle = 2 * dexcube_env::SETTLE_STEPS;
+    let mut steps = Vec::new();
+    for held in [None, Some(3)] {
+        let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
+        set_up_scramble(&mut sim, &[], resting);
+        stages.stage1.driving = Driving {
+            stage1_held_steps: held,
+            ..Driving::default()
+        };
+        let run = stages.stage1.run(&mut sim, resting, target, &mut |_| {});
+        assert!(!run.dropped && !run.diverged);
+        steps.push(run.steps);
+        if held.is_some() {
+            assert!(accepts(&sim, resting, target), "it ended on the pose");
+        }
+    }
+    assert_eq!(steps[0], settle + dexcube_env::EPISODE_STEPS);
+    assert!(
+        (settle + 3..steps[0]).contains(&steps[1]),
+        "held 3 steps, then ended: {steps:?}"
+    );
+}
+
+/// Opening gradually moves the hand's targets from where the last stage left them to the flat
+/// hand over the settling steps; otherwise they jump to the flat hand at the first step.
+#[test]
+fn gradual_opening_ramps_the_hand_from_where_it_was() {
+    let (mut stages, resting) = shipped_stages();
+    let scene = Scene::load(SceneKind::Cube).unwrap();
+    let open = scene.open_hand_action();
+    let bent = [0.5; dexcube_sim::HAND_ACTUATORS];
+    for gradual_opening in [false, true] {
+        let mut sim = Sim::new(scene.clone());
+        set_up_scramble(&mut sim, &[], resting);
+        sim.set_action(&bent);
+        stages.stage2.driving = Driving {
+            gradual_opening,
+            ..Driving::default()
+        };
+        let mut targets = Vec::new();
+        stages
+            .stage2
+            .run(&mut sim, &mut |sim| targets.push(sim.action()));
+        let steps = dexcube_env::SETTLE_STEPS;
+        for (k, target) in targets[..steps].iter().enumerate() {
+            let t = if gradual_opening {
+                (k + 1) as f64 / steps as f64
+            } else {
+                1.0
+            };
+            for i in 0..dexcube_sim::HAND_ACTUATORS {
+                let expected = (bent[i] + t * (open[i] - bent[i])).clamp(-1.0, 1.0);
+                assert!(
+                    (target[i] - expected).abs() < 1e-9,
+                    "step {k}, actuator {i}: {} against {expected}",
+                    target[i]
+                );
+            }
+        }
+        assert_eq!(targets[steps], [0.0; dexcube_sim::HAND_ACTUATORS]);
+    }
+}
+
+/// The shipped policies, loaded for the cube scene, and the cube's resting point.
+fn shipped_stages() -> (dexcube_operator::eval::LoadedStages, [f64; 3]) {
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let files = dexcube_operator::eval::PolicyFiles {
+        rot: models.join("rot"),
+        layer: models.join("layer"),
+        rot_mode: RotMode::Pair,
+    };
+    let resting = dexcube_operator::eval::resting_point().unwrap();
+    (files.load(resting).unwrap(), resting)
 }

@@ -216,6 +216,13 @@ impl Scene {
         }
     }
 
+    /// The action whose targets are `ctrl` (the inverse of `action_to_ctrl` within range).
+    pub fn ctrl_to_action(&self, ctrl: &[f64]) -> [f64; HAND_ACTUATORS] {
+        std::array::from_fn(|i| {
+            ((ctrl[i] - self.ctrl_centre[i]) / self.ctrl_half_range[i]).clamp(-1.0, 1.0)
+        })
+    }
+
     /// The action whose targets are the model's zero pose (the open, flat hand every
     /// episode starts from), clamped into the actuators' ranges.
     pub fn open_hand_action(&self) -> [f64; HAND_ACTUATORS] {

@@ -107,6 +107,12 @@ impl Sim {
             .action_to_ctrl(action, &mut self.data.ctrl_mut()[..HAND_ACTUATORS]);
     }
 
+    /// The hand's current action: the one whose targets the actuators now hold.
+    pub fn action(&self) -> [f64; HAND_ACTUATORS] {
+        self.scene
+            .ctrl_to_action(&self.data.ctrl()[..HAND_ACTUATORS])
+    }
+
     /// One control step: `SUBSTEPS` physics steps. Fails if the state blew up, in which case
     /// the caller should `reset`.
     pub fn step(&mut self) -> Result<(), SimError> {
