@@ -33,6 +33,20 @@ fn font() -> Result<(), String> {
         .clone()
 }
 
+/// Matplotlib's "tab10" colours: distinct from each other and legible on white.
+const TAB10: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
 /// One curve: a label, points, and an optional band (lower, upper) around them.
 pub struct Series {
     pub label: String,
@@ -40,7 +54,9 @@ pub struct Series {
     pub band: Option<Vec<(f64, f64, f64)>>,
 }
 
-/// Draws `series` against a shared x axis into a 800x500 PNG, y from 0 to `y_max`.
+/// Draws `series` against a shared x axis into a 1000x500 PNG, y from 0 to `y_max`, with the
+/// legend in a panel of its own on the right, where it cannot cover a curve. Series without
+/// points are left out.
 pub fn line_plot(
     path: &Path,
     title: &str,
@@ -57,9 +73,10 @@ pub fn line_plot(
     let mut temporary = path.to_path_buf();
     temporary.set_extension("tmp.png");
     {
-        let root = BitMapBackend::new(&temporary, (800, 500)).into_drawing_area();
+        let root = BitMapBackend::new(&temporary, (1000, 500)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let mut chart = ChartBuilder::on(&root)
+        let (plot_area, legend_area) = root.split_horizontally(760);
+        let mut chart = ChartBuilder::on(&plot_area)
             .caption(title, ("sans-serif", 22))
             .margin(15)
             .x_label_area_size(40)
@@ -72,8 +89,9 @@ pub fn line_plot(
             .y_desc(y_label)
             .draw()
             .map_err(|e| e.to_string())?;
-        for (i, s) in series.iter().enumerate() {
-            let colour = Palette99::pick(i).to_rgba();
+        let drawn = series.iter().filter(|s| !s.points.is_empty());
+        for (i, s) in drawn.enumerate() {
+            let colour = TAB10[i % TAB10.len()].to_rgba();
             if let Some(band) = &s.band {
                 let upper = band.iter().map(|&(x, _, hi)| (x, hi));
                 let lower = band.iter().rev().map(|&(x, lo, _)| (x, lo));
@@ -84,19 +102,15 @@ pub fn line_plot(
             }
             chart
                 .draw_series(LineSeries::new(s.points.clone(), colour.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(s.label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+                .map_err(|e| e.to_string())?;
+            let y = 60 + 24 * i as i32;
+            legend_area
+                .draw(&PathElement::new([(0, y), (24, y)], colour.stroke_width(2)))
+                .map_err(|e| e.to_string())?;
+            legend_area
+                .draw(&Text::new(s.label.clone(), (32, y - 8), ("sans-serif", 14)))
+                .map_err(|e| e.to_string())?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())?;
     }
     std::fs::rename(&temporary, path).map_err(|e| e.to_string())
