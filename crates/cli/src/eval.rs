@@ -77,26 +77,28 @@ impl OperatorArgs {
         }
     }
 
-    /// The operator's name in a run's record.
+    /// The operator's name in a run's record: "paper" for the paper's own (as Table I's
+    /// record names it), otherwise its planner and how it drives the policies.
     fn name(self) -> String {
         let driving = self.config(true).driving;
-        let mut name = if self.paper_operator {
-            "paper".to_string()
+        if self.paper_operator && driving == Driving::default() {
+            return "paper".to_string();
+        }
+        let planner = if self.paper_operator {
+            "paper"
         } else {
-            "planning for the hand".to_string()
+            "planning for the hand"
         };
-        if driving.gradual_opening {
-            name += ", opening the hand gradually";
-        } else if self.opening.is_some() || !self.paper_operator {
-            name += ", opening the hand at once";
-        }
-        if !self.paper_operator || self.stage1_held.is_some() {
-            match driving.stage1_held_steps {
-                Some(steps) => name += &format!(", Stage 1 ends once held {steps} steps"),
-                None => name += ", whole Stage 1 episodes",
-            }
-        }
-        name
+        let opening = if driving.gradual_opening {
+            "gradually"
+        } else {
+            "at once"
+        };
+        let stage1 = match driving.stage1_held_steps {
+            Some(steps) => format!("Stage 1 ends once held {steps} steps"),
+            None => "whole Stage 1 episodes".to_string(),
+        };
+        format!("{planner}, opening the hand {opening}, {stage1}")
     }
 
     /// The flags that select this operator, as a command line names them.

@@ -209,10 +209,18 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
         .collect();
     let refused = dexcube(&other_seed, "");
     assert_clean_failure(&refused, 2, "holds results of other policies, another seed");
-    // So would continuing it with the paper's operator.
-    let paper_operator = [&args[..], &["--paper-operator"]].concat();
-    let refused = dexcube(&paper_operator, "");
-    assert_clean_failure(&refused, 2, "or another operator");
+    // So would continuing it with the paper's operator, or driving the stages otherwise.
+    for other in [
+        &["--paper-operator"][..],
+        &["--stage1-held", "0"],
+        &["--opening", "at-once"],
+    ] {
+        let refused = dexcube(&[&args[..], other].concat(), "");
+        assert_clean_failure(&refused, 2, "or another operator");
+    }
+    // Naming the defaults is the same operator.
+    let defaults = [&args[..], &["--stage1-held", "5", "--opening", "gradual"]].concat();
+    assert!(dexcube(&defaults, "").status.success());
 }
 
 #[test]
