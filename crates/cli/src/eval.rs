@@ -46,6 +46,19 @@ pub struct OperatorArgs {
     /// gradual planning for the hand, at-once with --paper-operator.
     #[arg(long, value_enum)]
     pub opening: Option<Opening>,
+    /// Planning for the hand, when Stage 1 is skipped for a face already up: `pose`, when
+    /// Stage 1's whole test passes; `face`, when the face is up wherever the cube lies.
+    #[arg(long, value_enum, default_value_t = AlreadyUp::Pose, conflicts_with = "paper_operator")]
+    pub already_up: AlreadyUp,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+pub enum AlreadyUp {
+    /// Stage 1's own test: the face up within 0.1 rad and the cube within 0.01 m of its
+    /// resting point.
+    Pose,
+    /// The face up within 0.1 rad, anywhere on the palm.
+    Face,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
@@ -69,6 +82,7 @@ impl OperatorArgs {
         if let Some(opening) = self.opening {
             driving.gradual_opening = opening == Opening::Gradual;
         }
+        driving.already_up_anywhere = self.already_up == AlreadyUp::Face;
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
@@ -98,7 +112,12 @@ impl OperatorArgs {
             Some(steps) => format!("Stage 1 ends once held {steps} steps"),
             None => "whole Stage 1 episodes".to_string(),
         };
-        format!("{planner}, opening the hand {opening}, {stage1}")
+        let skip = if driving.already_up_anywhere {
+            ", no Stage 1 when the face is up anywhere on the palm"
+        } else {
+            ""
+        };
+        format!("{planner}, opening the hand {opening}, {stage1}{skip}")
     }
 
     /// The flags that select this operator, as a command line names them.
@@ -116,7 +135,11 @@ impl OperatorArgs {
             Some(Opening::Gradual) => " --opening gradual",
             None => "",
         };
-        format!("{paper}{held}{opening}")
+        let already_up = match self.already_up {
+            AlreadyUp::Pose => "",
+            AlreadyUp::Face => " --already-up face",
+        };
+        format!("{paper}{held}{opening}{already_up}")
     }
 }
 

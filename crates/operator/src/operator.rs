@@ -262,7 +262,12 @@ impl Operator<'_> {
         let (up, turns) = move_plan(m);
         let target = stage1_target(up);
         let mut stage1_attempts = self.config.stage1_attempts;
-        if self.config.plan_for_hand && (self.stage1_accepts)(sim, self.resting, target) {
+        let up_at = if self.config.driving.already_up_anywhere {
+            sim.object_pose().position
+        } else {
+            self.resting
+        };
+        if self.config.plan_for_hand && (self.stage1_accepts)(sim, up_at, target) {
             narrate(&Event::AlreadyUp(up));
             stage1_attempts = 0;
         }

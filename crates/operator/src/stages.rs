@@ -65,12 +65,17 @@ pub struct Driving {
     /// End Stage 1 once its pose test has passed for this many control steps running,
     /// rather than after the policy's whole episode.
     pub stage1_held_steps: Option<usize>,
+    /// Planning for the hand, skip Stage 1 when the move's face is up within Stage 1's angle
+    /// test wherever the cube lies on the palm, rather than only when its whole test passes
+    /// (the position within 0.01 m of the resting point as well).
+    pub already_up_anywhere: bool,
 }
 
 impl Driving {
     pub const FOR_HAND: Driving = Driving {
         gradual_opening: true,
         stage1_held_steps: Some(5),
+        already_up_anywhere: false,
     };
 }
 

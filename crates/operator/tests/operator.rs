@@ -375,3 +375,39 @@ fn shipped_stages() -> (dexcube_operator::eval::LoadedStages, [f64; 3]) {
     let resting = dexcube_operator::eval::resting_point().unwrap();
     (files.load(resting).unwrap(), resting)
 }
+
+/// A cube with the right face up but 2 cm from its resting point: Stage 1's whole test
+/// refuses that pose, so by default the operator re-poses it first; told that the face up is
+/// enough (`already_up_anywhere`), it turns the layer at once.
+#[test]
+fn a_face_up_away_from_the_resting_point_skips_stage_1_only_when_told() {
+    let table = DistanceTable::build();
+    let mut actions = Vec::new();
+    for already_up_anywhere in [false, true] {
+        let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
+        let aside = [RESTING[0] + 0.02, RESTING[1], RESTING[2]];
+        let scramble = dexcube_cube::parse_moves("U").unwrap();
+        set_up_scramble(&mut sim, &scramble, aside);
+        let accepts = pose_reached(RotMode::Pair);
+        let mut operator = Operator {
+            config: OperatorConfig {
+                driving: Driving {
+                    already_up_anywhere,
+                    ..Driving::FOR_HAND
+                },
+                ..OperatorConfig::default()
+            },
+            stage1: &mut KinematicStage1,
+            stage1_accepts: &accepts,
+            stage2: &mut KinematicStage2 { angle: U_PRIME },
+            table: &table,
+            resting: RESTING,
+            rng: ChaCha8Rng::seed_from_u64(0),
+            watch: &mut |_| {},
+        };
+        let outcome = operator.solve(&mut sim, &mut |_| {});
+        assert!(outcome.solved, "{outcome:?}");
+        actions.push(outcome.actions);
+    }
+    assert_eq!(actions, [2, 1], "Stage 1 then U', or U' alone");
+}
