@@ -319,7 +319,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         let rows = table(&sorted, &distances);
         write_atomically(
             &args.out.with_extension("md"),
-            markdown(&rows, &command).as_bytes(),
+            markdown(&rows, &sorted, &command).as_bytes(),
         )?;
         Ok(())
     };
@@ -346,6 +346,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 replans: outcome.replans,
                 control_steps: outcome.control_steps,
                 failure: outcome.failure_text(),
+                stages: Some(outcome.stages),
             };
             let mut all = shared.lock().expect("lock");
             all.push(row);
@@ -365,7 +366,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     if let Err(e) = plot(&rows, &args.out) {
         eprintln!("warning: no plot: {e}");
     }
-    print!("{}", markdown(&rows, &command));
+    print!("{}", markdown(&rows, &results, &command));
     Ok(ExitCode::SUCCESS)
 }
 

@@ -14,7 +14,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::operator::{Operator, OperatorConfig, set_up_scramble};
+use crate::operator::{Operator, OperatorConfig, StageRecord, set_up_scramble};
 use crate::stages::{Driving, PolicyStage1, PolicyStage2, pose_reached};
 
 /// The paper's Table I, move distances 1 to 14.
@@ -81,15 +81,22 @@ pub struct CubeResult {
     pub replans: usize,
     pub control_steps: usize,
     pub failure: String,
+    /// How the stages fared; `None` in rows written before it was recorded.
+    pub stages: Option<StageRecord>,
 }
 
 impl CubeResult {
-    pub const CSV_HEADER: &'static str =
-        "distance,index,rollback,solved,actions,randomisations,replans,control_steps,failure";
+    pub const CSV_HEADER: &'static str = "distance,index,rollback,solved,actions,randomisations,replans,control_steps,failure,stage1_runs,stage1_reached,stage2_runs,stage2_misaligned";
 
     pub fn csv_row(&self) -> String {
+        let stages = self.stages.map_or(",,,".to_string(), |s| {
+            format!(
+                "{},{},{},{}",
+                s.stage1_runs, s.stage1_reached, s.stage2_runs, s.stage2_misaligned
+            )
+        });
         format!(
-            "{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{stages}",
             self.distance,
             self.index,
             self.rollback,
@@ -102,12 +109,30 @@ impl CubeResult {
         )
     }
 
+    /// The stage whose run ended the attempt (the cube dropped or the physics blew up), from
+    /// the failure text ("Dropped in Stage 1 at step 35").
+    pub fn failed_stage(&self) -> Option<usize> {
+        let (_, after) = self.failure.split_once(" in Stage ")?;
+        after.split(' ').next()?.parse().ok()
+    }
+
+    /// A row of the CSV: 13 fields, or the 9 of rows written before the stages were
+    /// recorded.
     pub fn from_csv(line: &str) -> Option<CubeResult> {
         let f: Vec<&str> = line.trim().split(',').collect();
-        if f.len() != 9 {
-            return None;
-        }
+        let stages = match f.len() {
+            9 => None,
+            13 if f[9..].iter().all(|x| x.is_empty()) => None,
+            13 => Some(StageRecord {
+                stage1_runs: f[9].parse().ok()?,
+                stage1_reached: f[10].parse().ok()?,
+                stage2_runs: f[11].parse().ok()?,
+                stage2_misaligned: f[12].parse().ok()?,
+            }),
+            _ => return None,
+        };
         Some(CubeResult {
+            stages,
             distance: f[0].parse().ok()?,
             index: f[1].parse().ok()?,
             rollback: f[2].parse().ok()?,
@@ -205,8 +230,8 @@ pub fn table(results: &[CubeResult], distances: &[usize]) -> Vec<TableRow> {
         .collect()
 }
 
-/// Table I as markdown, ours beside the paper's.
-pub fn markdown(rows: &[TableRow], command: &str) -> String {
+/// Table I as markdown, ours beside the paper's, and how the stages fared in `results`.
+pub fn markdown(rows: &[TableRow], results: &[CubeResult], command: &str) -> String {
     let cell = |n: usize, x: f64, digits: usize| {
         if n == 0 {
             "-".to_string()
@@ -231,6 +256,47 @@ pub fn markdown(rows: &[TableRow], command: &str) -> String {
             PAPER_SR_OPEN_LOOP[k],
             cell(r.cubes_open_loop, r.an_open_loop, 2),
             PAPER_AN_OPEN_LOOP[k],
+        );
+    }
+    out + &stages_markdown(results)
+}
+
+/// The atomic actions as they fared inside the attempts, for each variant, over the rows
+/// that record them (none: an empty string): how often Stage 1 reached its pose and how often
+/// Stage 2 left the cube out of its good state, and how often each dropped the cube, as
+/// shares of their runs.
+fn stages_markdown(results: &[CubeResult]) -> String {
+    let mut out = String::new();
+    for (variant, rollback) in [("with rollback", true), ("open loop", false)] {
+        let rows: Vec<(&CubeResult, StageRecord)> = results
+            .iter()
+            .filter(|r| r.rollback == rollback)
+            .filter_map(|r| Some((r, r.stages?)))
+            .collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let ended_by = |stage| {
+            rows.iter()
+                .filter(|(r, _)| r.failed_stage() == Some(stage))
+                .count()
+        };
+        let sum = |f: fn(&StageRecord) -> usize| rows.iter().map(|(_, s)| f(s)).sum::<usize>();
+        let (drops1, drops2) = (ended_by(1), ended_by(2));
+        let runs1 = sum(|s| s.stage1_runs) + drops1;
+        let runs2 = sum(|s| s.stage2_runs) + drops2;
+        let share =
+            |n: usize, of: usize| format!("{n} ({:.1}%)", 100.0 * n as f64 / of.max(1) as f64);
+        if out.is_empty() {
+            out += "\nThe atomic actions inside the attempts (a run that dropped the cube or blew up the physics ended its attempt):\n\n| variant | cubes | Stage 1 runs | pose reached | dropped | Stage 2 runs | cube left out of its good state | dropped |\n|---|---|---|---|---|---|---|---|\n";
+        }
+        out += &format!(
+            "| {variant} | {} | {runs1} | {} | {} | {runs2} | {} | {} |\n",
+            rows.len(),
+            share(sum(|s| s.stage1_reached), runs1),
+            share(drops1, runs1),
+            share(sum(|s| s.stage2_misaligned), runs2),
+            share(drops2, runs2),
         );
     }
     out
@@ -344,6 +410,7 @@ mod tests {
             replans: 0,
             control_steps: 0,
             failure: String::new(),
+            stages: None,
         };
         let rows = table(
             &[
@@ -365,5 +432,44 @@ mod tests {
         assert_eq!(rows[1].cubes_rollback, 0);
         let line = r(3, false, true, 9).csv_row();
         assert_eq!(CubeResult::from_csv(&line), Some(r(3, false, true, 9)));
+    }
+
+    /// Rows record how the stages fared, rows from before that still read, and the table
+    /// sums the stages over the rows that have them.
+    #[test]
+    fn stage_records_round_trip_and_are_summed() {
+        let old = "2,7,true,false,5,1,0,518,Dropped";
+        let row = CubeResult::from_csv(old).unwrap();
+        assert_eq!((row.stages, row.failed_stage()), (None, None));
+        assert_eq!(CubeResult::from_csv(&row.csv_row()), Some(row.clone()));
+        let recorded = CubeResult {
+            failure: "Dropped in Stage 1 at step 35".to_string(),
+            stages: Some(StageRecord {
+                stage1_runs: 3,
+                stage1_reached: 2,
+                stage2_runs: 4,
+                stage2_misaligned: 1,
+            }),
+            ..row.clone()
+        };
+        assert_eq!(recorded.failed_stage(), Some(1));
+        assert_eq!(
+            CubeResult::from_csv(&recorded.csv_row()),
+            Some(recorded.clone())
+        );
+        let solved = CubeResult {
+            solved: true,
+            failure: String::new(),
+            ..recorded.clone()
+        };
+        let text = stages_markdown(&[row, recorded, solved]);
+        assert!(
+            text.contains(
+                "| with rollback | 2 | 7 | 4 (57.1%) | 1 (14.3%) | 8 | 2 (25.0%) | 0 (0.0%) |"
+            ),
+            "{text}"
+        );
+        assert!(!text.contains("open loop"));
+        assert_eq!(stages_markdown(&[]), "");
     }
 }

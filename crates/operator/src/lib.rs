@@ -11,5 +11,6 @@ pub mod operator;
 pub mod stages;
 
 pub use operator::{
-    Event, Failure, Operator, OperatorConfig, Outcome, hand_cost, move_plan, set_up_scramble,
+    Event, Failure, Operator, OperatorConfig, Outcome, StageRecord, hand_cost, move_plan,
+    set_up_scramble,
 };

@@ -56,6 +56,19 @@ pub struct Outcome {
     /// The stage (1 or 2) that dropped the cube or blew up the physics, and at which of its
     /// control steps (counting the hand's settling steps before the policy acts).
     pub failed_at: Option<(usize, usize)>,
+    pub stages: StageRecord,
+}
+
+/// How the atomic actions fared inside one attempt, as the operator saw them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct StageRecord {
+    /// Stage 1 runs, and those after which the pose check passed.
+    pub stage1_runs: usize,
+    pub stage1_reached: usize,
+    /// Stage 2 runs, and those that left the cube out of its good state (a layer part-way or
+    /// another layer knocked out of square), whether or not the rollback then restored it.
+    pub stage2_runs: usize,
+    pub stage2_misaligned: usize,
 }
 
 impl Outcome {
@@ -278,6 +291,8 @@ impl Operator<'_> {
                 return Some(failure);
             }
             let ok = (self.stage1_accepts)(sim, self.resting, target);
+            outcome.stages.stage1_runs += 1;
+            outcome.stages.stage1_reached += usize::from(ok);
             narrate(&Event::Stage1 {
                 face: up,
                 landed: face_up(sim),
@@ -301,6 +316,9 @@ impl Operator<'_> {
                 narrate(&Event::Ended { stage: 2, failure });
                 return Some(failure);
             }
+            outcome.stages.stage2_runs += 1;
+            outcome.stages.stage2_misaligned +=
+                usize::from(!CubeState::read(sim).is_some_and(|s| s.is_aligned()));
             if self.config.rollback {
                 let mut restores = 0;
                 while !CubeState::read(sim).is_some_and(|s| s.is_aligned()) {

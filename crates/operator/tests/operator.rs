@@ -99,6 +99,10 @@ fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
                 plan.iter().map(|&m| 1 + move_plan(m).1).sum()
             };
             assert_eq!(outcome.actions, expected, "distance {distance}, {config:?}");
+            let stages = outcome.stages;
+            assert_eq!(stages.stage1_runs + stages.stage2_runs, outcome.actions);
+            assert_eq!(stages.stage1_reached, stages.stage1_runs);
+            assert_eq!(stages.stage2_misaligned, 0);
             actions[usize::from(plan_for_hand)] += outcome.actions;
         }
     }
@@ -169,6 +173,7 @@ fn a_misaligned_cube_after_stage_2_is_restored_to_a_good_state() {
     let outcome = attempt(&mut KinematicStage1, &mut sloppy_once(), true, 3, 5);
     assert!(outcome.solved, "{outcome:?}");
     assert!(outcome.randomisations >= 1, "{outcome:?}");
+    assert_eq!(outcome.stages.stage2_misaligned, 1, "{outcome:?}");
 }
 
 #[test]
