@@ -579,6 +579,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     };
     let endings: [AtomicUsize; 7] = Default::default();
     let held: [AtomicUsize; HOLDS.len()] = Default::default();
+    let wins_out_of_square = AtomicUsize::new(0);
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
         EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
@@ -609,8 +610,11 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         |(policy, env), k| {
             let trace = episode(env.as_mut(), policy, args.seed + k as u64);
             let turning = args.stage == EnvKind::Layer;
-            endings[Ending::of(&trace.info, thresholds, turning, trace.square) as usize]
-                .fetch_add(1, Ordering::Relaxed);
+            let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
+            endings[ending as usize].fetch_add(1, Ordering::Relaxed);
+            if ending == Ending::Success && !trace.square {
+                wins_out_of_square.fetch_add(1, Ordering::Relaxed);
+            }
             for (count, steps) in held.iter().zip(HOLDS) {
                 if trace.longest_hold >= steps {
                     count.fetch_add(1, Ordering::Relaxed);
@@ -650,6 +654,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         if n > 0 {
             println!("  {}: {n}", ending.name());
         }
+    }
+    let wins_out_of_square = wins_out_of_square.into_inner();
+    if wins_out_of_square > 0 {
+        println!(
+            "  successes that left the cube out of its good state (a cubelet over 0.1 rad off): {wins_out_of_square}"
+        );
     }
     for (count, steps) in held.iter().zip(HOLDS) {
         println!(
