@@ -50,6 +50,11 @@ pub struct OperatorArgs {
     /// Stage 1's whole test passes; `face`, when the face is up wherever the cube lies.
     #[arg(long, value_enum, default_value_t = AlreadyUp::Pose, conflicts_with = "paper_operator")]
     pub already_up: AlreadyUp,
+    /// With rollback, Stage 1 also needs the cube in its good state (every cubelet in line):
+    /// a cube it leaves with a layer skewed is squared up and re-posed by randomisation, as a
+    /// pose that is off is, before Stage 2 tries to turn it.
+    #[arg(long)]
+    pub stage1_good_state: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
@@ -83,6 +88,7 @@ impl OperatorArgs {
             driving.gradual_opening = opening == Opening::Gradual;
         }
         driving.already_up_anywhere = self.already_up == AlreadyUp::Face;
+        driving.stage1_good_state = self.stage1_good_state;
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
@@ -117,7 +123,12 @@ impl OperatorArgs {
         } else {
             ""
         };
-        format!("{planner}, opening the hand {opening}, {stage1}{skip}")
+        let square = if driving.stage1_good_state {
+            ", Stage 1 also needs the good state"
+        } else {
+            ""
+        };
+        format!("{planner}, opening the hand {opening}, {stage1}{skip}{square}")
     }
 
     /// The flags that select this operator, as a command line names them.
@@ -139,7 +150,12 @@ impl OperatorArgs {
             AlreadyUp::Pose => "",
             AlreadyUp::Face => " --already-up face",
         };
-        format!("{paper}{held}{opening}{already_up}")
+        let square = if self.stage1_good_state {
+            " --stage1-good-state"
+        } else {
+            ""
+        };
+        format!("{paper}{held}{opening}{already_up}{square}")
     }
 }
 

@@ -290,9 +290,11 @@ impl Operator<'_> {
                 narrate(&Event::Ended { stage: 1, failure });
                 return Some(failure);
             }
-            let ok = (self.stage1_accepts)(sim, self.resting, target);
+            let posed = (self.stage1_accepts)(sim, self.resting, target);
+            let square = !self.config.driving.stage1_good_state || in_good_state(sim);
+            let ok = posed && square;
             outcome.stages.stage1_runs += 1;
-            outcome.stages.stage1_reached += usize::from(ok);
+            outcome.stages.stage1_reached += usize::from(posed);
             narrate(&Event::Stage1 {
                 face: up,
                 landed: face_up(sim),
@@ -302,11 +304,16 @@ impl Operator<'_> {
             if ok || !self.config.rollback || attempt == stage1_attempts {
                 break;
             }
+            if !square {
+                snap_layers(sim);
+            }
             randomise_pose(sim, self.resting, &mut self.rng);
             outcome.randomisations += 1;
-            narrate(&Event::Randomised(
-                "the pose was off: random pose, then Stage 1 again",
-            ));
+            narrate(&Event::Randomised(if square {
+                "the pose was off: random pose, then Stage 1 again"
+            } else {
+                "not in a good state: layers restored, random pose, then Stage 1 again"
+            }));
         }
         for turn in 1..=turns {
             let run = self.stage2.run(sim, &mut *self.watch);
@@ -317,11 +324,10 @@ impl Operator<'_> {
                 return Some(failure);
             }
             outcome.stages.stage2_runs += 1;
-            outcome.stages.stage2_misaligned +=
-                usize::from(!CubeState::read(sim).is_some_and(|s| s.is_aligned()));
+            outcome.stages.stage2_misaligned += usize::from(!in_good_state(sim));
             if self.config.rollback {
                 let mut restores = 0;
-                while !CubeState::read(sim).is_some_and(|s| s.is_aligned()) {
+                while !in_good_state(sim) {
                     if restores == self.config.restores {
                         return Some(Failure::StuckMisaligned);
                     }
@@ -342,6 +348,11 @@ impl Operator<'_> {
         }
         None
     }
+}
+
+/// Whether the cube is in the paper's good state: every cubelet in line.
+fn in_good_state(sim: &Sim) -> bool {
+    CubeState::read(sim).is_some_and(|s| s.is_aligned())
 }
 
 /// The cube's stickers in its own frame, if they can be read.

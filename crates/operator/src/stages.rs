@@ -69,6 +69,9 @@ pub struct Driving {
     /// test wherever the cube lies on the palm, rather than only when its whole test passes
     /// (the position within 0.01 m of the resting point as well).
     pub already_up_anywhere: bool,
+    /// With rollback, Stage 1 also needs the cube in its good state: a cube it leaves with a
+    /// layer skewed is squared up and re-posed by randomisation, as a pose that is off is.
+    pub stage1_good_state: bool,
 }
 
 impl Driving {
@@ -76,6 +79,7 @@ impl Driving {
         gradual_opening: true,
         stage1_held_steps: Some(5),
         already_up_anywhere: false,
+        stage1_good_state: false,
     };
 }
 

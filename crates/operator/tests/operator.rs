@@ -46,8 +46,38 @@ fn attempt_judged(
 ) -> Outcome {
     let table = DistanceTable::build();
     let scramble = scrambles_at_distance(&table, distance, 1, seed).remove(0);
+    let judged = (mode, config);
+    solve_from(
+        &scramble.moves,
+        RESTING,
+        judged,
+        (stage1, stage2),
+        seed,
+        &mut |_| {},
+    )
+}
+
+/// The default operator, driving the stages as `driving` says.
+fn driven(driving: Driving) -> OperatorConfig {
+    OperatorConfig {
+        driving,
+        ..OperatorConfig::default()
+    }
+}
+
+/// Solves `scramble`, made kinematically on the palm at `at`, with the given stages, Stage 1
+/// judged in `mode`, the operator configured by `config` and randomising from `seed`.
+fn solve_from(
+    scramble: &[dexcube_cube::Move],
+    at: [f64; 3],
+    (mode, config): (RotMode, OperatorConfig),
+    (stage1, stage2): (&mut dyn Stage1, &mut dyn Stage2),
+    seed: u64,
+    narrate: &mut dyn FnMut(&dexcube_operator::Event),
+) -> Outcome {
+    let table = DistanceTable::build();
     let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
-    set_up_scramble(&mut sim, &scramble.moves, RESTING);
+    set_up_scramble(&mut sim, scramble, at);
     let accepts = pose_reached(mode);
     let mut operator = Operator {
         config,
@@ -59,7 +89,7 @@ fn attempt_judged(
         rng: ChaCha8Rng::seed_from_u64(seed),
         watch: &mut |_| {},
     };
-    operator.solve(&mut sim, &mut |_| {})
+    operator.solve(&mut sim, narrate)
 }
 
 /// The paper's operator runs Stage 1 and then 1 or 3 Stage 2 runs for each move of the
@@ -386,33 +416,69 @@ fn shipped_stages() -> (dexcube_operator::eval::LoadedStages, [f64; 3]) {
 /// enough (`already_up_anywhere`), it turns the layer at once.
 #[test]
 fn a_face_up_away_from_the_resting_point_skips_stage_1_only_when_told() {
-    let table = DistanceTable::build();
+    let scramble = dexcube_cube::parse_moves("U").unwrap();
+    let aside = [RESTING[0] + 0.02, RESTING[1], RESTING[2]];
     let mut actions = Vec::new();
     for already_up_anywhere in [false, true] {
-        let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
-        let aside = [RESTING[0] + 0.02, RESTING[1], RESTING[2]];
-        let scramble = dexcube_cube::parse_moves("U").unwrap();
-        set_up_scramble(&mut sim, &scramble, aside);
-        let accepts = pose_reached(RotMode::Pair);
-        let mut operator = Operator {
-            config: OperatorConfig {
-                driving: Driving {
-                    already_up_anywhere,
-                    ..Driving::FOR_HAND
-                },
-                ..OperatorConfig::default()
-            },
-            stage1: &mut KinematicStage1,
-            stage1_accepts: &accepts,
-            stage2: &mut KinematicStage2 { angle: U_PRIME },
-            table: &table,
-            resting: RESTING,
-            rng: ChaCha8Rng::seed_from_u64(0),
-            watch: &mut |_| {},
-        };
-        let outcome = operator.solve(&mut sim, &mut |_| {});
+        let config = driven(Driving {
+            already_up_anywhere,
+            ..Driving::FOR_HAND
+        });
+        let stages = (
+            &mut KinematicStage1 as &mut dyn Stage1,
+            &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
+        );
+        let judged = (RotMode::Pair, config);
+        let outcome = solve_from(&scramble, aside, judged, stages, 0, &mut |_| {});
         assert!(outcome.solved, "{outcome:?}");
         actions.push(outcome.actions);
     }
     assert_eq!(actions, [2, 1], "Stage 1 then U', or U' alone");
+}
+
+/// A Stage 1 that reaches its pose but leaves the layer on the cube's right skewed by 0.3 rad
+/// on its first run.
+struct SkewingStage1 {
+    skews: usize,
+}
+
+impl Stage1 for SkewingStage1 {
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
+        let run = KinematicStage1.run(sim, position, target, watch);
+        if self.skews > 0 {
+            self.skews -= 1;
+            dexcube_sim::cube::turn_face_by(sim, Face::R, 0.3);
+            sim.forward();
+        }
+        run
+    }
+}
+
+/// Told that Stage 1 needs the good state too, the operator squares up a cube that Stage 1
+/// left skewed and runs Stage 1 again before turning; by default it goes on to Stage 2.
+#[test]
+fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
+    let table = DistanceTable::build();
+    let scramble = scrambles_at_distance(&table, 3, 1, 4).remove(0);
+    for stage1_good_state in [false, true] {
+        let config = driven(Driving {
+            stage1_good_state,
+            ..Driving::FOR_HAND
+        });
+        let stages = (
+            &mut SkewingStage1 { skews: 1 } as &mut dyn Stage1,
+            &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
+        );
+        let mut events = Vec::new();
+        let judged = (RotMode::Pair, config);
+        let outcome = solve_from(&scramble.moves, RESTING, judged, stages, 4, &mut |e| {
+            events.push(e.clone())
+        });
+        assert!(outcome.solved, "{outcome:?}");
+        assert!(outcome.stages.stage1_runs >= 2, "{outcome:?}");
+        let retried = events.iter().any(|e| {
+            matches!(e, dexcube_operator::Event::Randomised(why) if why.ends_with("then Stage 1 again"))
+        });
+        assert_eq!(retried, stage1_good_state, "{events:?}");
+    }
 }
