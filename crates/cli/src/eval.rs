@@ -87,12 +87,12 @@ impl OperatorArgs {
         if let Some(opening) = self.opening {
             driving.gradual_opening = opening == Opening::Gradual;
         }
-        driving.already_up_anywhere = self.already_up == AlreadyUp::Face;
-        driving.stage1_good_state = self.stage1_good_state;
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
             driving,
+            already_up_anywhere: self.already_up == AlreadyUp::Face,
+            stage1_good_state: self.stage1_good_state,
             ..OperatorConfig::default()
         }
     }
@@ -100,8 +100,9 @@ impl OperatorArgs {
     /// The operator's name in a run's record: "paper" for the paper's own (as Table I's
     /// record names it), otherwise its planner and how it drives the policies.
     fn name(self) -> String {
-        let driving = self.config(true).driving;
-        if self.paper_operator && driving == Driving::default() {
+        let config = self.config(true);
+        let driving = config.driving;
+        if self.paper_operator && driving == Driving::default() && !config.stage1_good_state {
             return "paper".to_string();
         }
         let planner = if self.paper_operator {
@@ -118,12 +119,12 @@ impl OperatorArgs {
             Some(steps) => format!("Stage 1 ends once held {steps} steps"),
             None => "whole Stage 1 episodes".to_string(),
         };
-        let skip = if driving.already_up_anywhere {
+        let skip = if config.already_up_anywhere {
             ", no Stage 1 when the face is up anywhere on the palm"
         } else {
             ""
         };
-        let square = if driving.stage1_good_state {
+        let square = if config.stage1_good_state {
             ", Stage 1 also needs the good state"
         } else {
             ""

@@ -62,10 +62,11 @@ pub struct Outcome {
 /// How the atomic actions fared inside one attempt, as the operator saw them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StageRecord {
-    /// Stage 1 runs, and those after which the pose check passed.
+    /// Stage 1 runs that kept the cube on the palm, and those after which the pose check
+    /// passed (a run that dropped it ended the attempt, and `Outcome::failed_at` names it).
     pub stage1_runs: usize,
     pub stage1_reached: usize,
-    /// Stage 2 runs, and those that left the cube out of its good state (a layer part-way or
+    /// Stage 2 runs that kept the cube on the palm, and those that left it out of its good state (a layer part-way or
     /// another layer knocked out of square), whether or not the rollback then restored it.
     pub stage2_runs: usize,
     pub stage2_misaligned: usize,
@@ -144,6 +145,13 @@ pub struct OperatorConfig {
     pub plan_for_hand: bool,
     /// How the policies are run on the cube.
     pub driving: Driving,
+    /// Planning for the hand, skip Stage 1 when the move's face is up within Stage 1's angle
+    /// test wherever the cube lies on the palm, rather than only when its whole test passes
+    /// (the position within 0.01 m of the resting point as well).
+    pub already_up_anywhere: bool,
+    /// With rollback, Stage 1 also needs the cube in its good state: a cube it leaves with a
+    /// layer skewed is squared up and re-posed by randomisation, as a pose that is off is.
+    pub stage1_good_state: bool,
 }
 
 impl Default for OperatorConfig {
@@ -155,6 +163,8 @@ impl Default for OperatorConfig {
             restores: 2,
             plan_for_hand: true,
             driving: Driving::FOR_HAND,
+            already_up_anywhere: false,
+            stage1_good_state: false,
         }
     }
 }
@@ -275,7 +285,7 @@ impl Operator<'_> {
         let (up, turns) = move_plan(m);
         let target = stage1_target(up);
         let mut stage1_attempts = self.config.stage1_attempts;
-        let up_at = if self.config.driving.already_up_anywhere {
+        let up_at = if self.config.already_up_anywhere {
             sim.object_pose().position
         } else {
             self.resting
@@ -291,7 +301,7 @@ impl Operator<'_> {
                 return Some(failure);
             }
             let posed = (self.stage1_accepts)(sim, self.resting, target);
-            let square = !self.config.driving.stage1_good_state || in_good_state(sim);
+            let square = !self.config.stage1_good_state || in_good_state(sim);
             let ok = posed && square;
             outcome.stages.stage1_runs += 1;
             outcome.stages.stage1_reached += usize::from(posed);

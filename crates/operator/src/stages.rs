@@ -65,21 +65,12 @@ pub struct Driving {
     /// End Stage 1 once its pose test has passed for this many control steps running,
     /// rather than after the policy's whole episode.
     pub stage1_held_steps: Option<usize>,
-    /// Planning for the hand, skip Stage 1 when the move's face is up within Stage 1's angle
-    /// test wherever the cube lies on the palm, rather than only when its whole test passes
-    /// (the position within 0.01 m of the resting point as well).
-    pub already_up_anywhere: bool,
-    /// With rollback, Stage 1 also needs the cube in its good state: a cube it leaves with a
-    /// layer skewed is squared up and re-posed by randomisation, as a pose that is off is.
-    pub stage1_good_state: bool,
 }
 
 impl Driving {
     pub const FOR_HAND: Driving = Driving {
         gradual_opening: true,
         stage1_held_steps: Some(5),
-        already_up_anywhere: false,
-        stage1_good_state: false,
     };
 }
 
@@ -107,28 +98,22 @@ fn drive(
     let open = sim.scene().open_hand_action();
     let from = if gradual_opening { sim.action() } else { open };
     let mut step = 0;
-    let opening = |_: &Sim| {
+    let settling = |_: &Sim| {
         step += 1;
+        if step > SETTLE_STEPS {
+            return vec![0.0; HAND_ACTUATORS];
+        }
         let t = step as f64 / SETTLE_STEPS as f64;
         from.iter()
             .zip(&open)
             .map(|(a, b)| a + t * (b - a))
             .collect()
     };
-    let neutral = |_: &Sim| vec![0.0; HAND_ACTUATORS];
     let never = &mut |_: &Sim| false;
     if !advance(
         sim,
-        opening,
-        SETTLE_STEPS,
-        resting_z,
-        watch,
-        never,
-        &mut run,
-    ) || !advance(
-        sim,
-        neutral,
-        SETTLE_STEPS,
+        settling,
+        2 * SETTLE_STEPS,
         resting_z,
         watch,
         never,

@@ -57,14 +57,6 @@ fn attempt_judged(
     )
 }
 
-/// The default operator, driving the stages as `driving` says.
-fn driven(driving: Driving) -> OperatorConfig {
-    OperatorConfig {
-        driving,
-        ..OperatorConfig::default()
-    }
-}
-
 /// Solves `scramble`, made kinematically on the palm at `at`, with the given stages, Stage 1
 /// judged in `mode`, the operator configured by `config` and randomising from `seed`.
 fn solve_from(
@@ -420,10 +412,10 @@ fn a_face_up_away_from_the_resting_point_skips_stage_1_only_when_told() {
     let aside = [RESTING[0] + 0.02, RESTING[1], RESTING[2]];
     let mut actions = Vec::new();
     for already_up_anywhere in [false, true] {
-        let config = driven(Driving {
+        let config = OperatorConfig {
             already_up_anywhere,
-            ..Driving::FOR_HAND
-        });
+            ..OperatorConfig::default()
+        };
         let stages = (
             &mut KinematicStage1 as &mut dyn Stage1,
             &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
@@ -461,10 +453,10 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
     let table = DistanceTable::build();
     let scramble = scrambles_at_distance(&table, 3, 1, 4).remove(0);
     for stage1_good_state in [false, true] {
-        let config = driven(Driving {
+        let config = OperatorConfig {
             stage1_good_state,
-            ..Driving::FOR_HAND
-        });
+            ..OperatorConfig::default()
+        };
         let stages = (
             &mut SkewingStage1 { skews: 1 } as &mut dyn Stage1,
             &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
