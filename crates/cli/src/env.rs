@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode};
+use dexcube_env::{
+    CubeRotEnv, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode,
+};
 use dexcube_sim::Scene;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -53,6 +55,11 @@ pub struct EnvChoice {
     /// rigid cube, its default). Block and rigid are quicker to simulate.
     #[arg(long)]
     pub object: Option<ObjectKind>,
+    /// LayerOpEnv on the physical cube only: success also needs the cube left in its good
+    /// state (every cubelet within 0.1 rad of a quarter turn); the goal gains the cube's
+    /// misalignment. The paper's test reads the turned layer only.
+    #[arg(long)]
+    pub square: bool,
 }
 
 impl EnvChoice {
@@ -72,12 +79,22 @@ impl EnvChoice {
         let scene = Scene::load(self.object()?.scene())?;
         Ok(match self.env {
             EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene, RotGoal::paper(self.mode))),
-            EnvKind::Layer => Box::new(LayerOpEnv::with_scene(
-                scene,
-                self.layer_move,
-                LayerGoals::Training,
-            )),
+            EnvKind::Layer => Box::new(
+                LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
+                    .with_goal(self.layer_goal()?),
+            ),
         })
+    }
+
+    /// LayerOpEnv's success test: the paper's, or with `--square` the good state as well.
+    pub fn layer_goal(&self) -> anyhow::Result<LayerGoal> {
+        if !self.square {
+            return Ok(LayerGoal::default());
+        }
+        if self.env != EnvKind::Layer || self.object()? != ObjectKind::Cube {
+            bail!("--square is for LayerOpEnv on the physical cube (train layer --object cube)");
+        }
+        Ok(LayerGoal::square())
     }
 
     /// The run's label. Runs on each environment's original object keep the label they had
@@ -87,9 +104,14 @@ impl EnvChoice {
             EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
+        let square = if self.layer_goal()?.square_threshold.is_some() {
+            ", left square"
+        } else {
+            ""
+        };
         Ok(match self.named_object()? {
-            None => format!("{what})"),
-            Some(object) => format!("{what}, {})", object.name()),
+            None => format!("{what}{square})"),
+            Some(object) => format!("{what}, {}{square})", object.name()),
         })
     }
 
@@ -177,9 +199,14 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
                 RotMode::Pair => "the target's up axis, either way up,",
             }
         ),
-        EnvKind::Layer => {
-            println!("  success:     layer angle within 0.1 rad of the goal; reward 0, else -1")
-        }
+        EnvKind::Layer => println!(
+            "  success:     layer angle within 0.1 rad of the goal{}; reward 0, else -1",
+            if choice.square {
+                ", every cubelet within 0.1 rad of a quarter turn"
+            } else {
+                ""
+            }
+        ),
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -19,7 +19,7 @@ use dexcube_operator::OperatorConfig;
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
-use dexcube_operator::stages::Driving;
+use dexcube_operator::stages::{Driving, PolicyStage2};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_sim::{Scene, SceneKind};
@@ -534,10 +534,11 @@ impl Ending {
     /// Stage 2's misses by an angle error of more than 67.5° from the quarter turn are the
     /// layer never turning (`turning` is true for Stage 2), told apart by whether the cube
     /// ended `square` (in its good state; a rigid object always is).
-    fn of(info: &Info, (position, angle): (f64, f64), turning: bool, square: bool) -> Ending {
-        if info.is_success {
+    fn of(info: &Info, thresholds: (f64, f64), turning: bool, square: bool) -> Ending {
+        if meets_paper_test(info, thresholds) {
             return Ending::Success;
         }
+        let (position, angle) = thresholds;
         if info.dropped || info.physics_error.is_some() {
             return Ending::Dropped;
         }
@@ -556,6 +557,16 @@ impl Ending {
     }
 }
 
+/// Whether a step met the paper's test, position and angle within `thresholds`, with the
+/// object on the palm. A policy trained on a stricter test (Stage 2 left square) is still
+/// judged by the paper's here; the good state is counted beside it.
+fn meets_paper_test(info: &Info, (position, angle): (f64, f64)) -> bool {
+    !info.dropped
+        && info.physics_error.is_none()
+        && info.position_error < position
+        && info.angle_error < angle
+}
+
 /// One deterministic episode of an atomic action: its last step's info, whether the object
 /// ended square (a physical cube in its good state; any other object always), and the
 /// longest run of consecutive steps at the goal before the end (or before a drop).
@@ -566,12 +577,21 @@ struct EpisodeTrace {
 }
 
 /// Runs a deterministic episode from `seed`.
-fn episode(env: &mut dyn SimulatedEnv, policy: &Policy, seed: u64) -> EpisodeTrace {
+fn episode(
+    env: &mut dyn SimulatedEnv,
+    policy: &Policy,
+    seed: u64,
+    thresholds: (f64, f64),
+) -> EpisodeTrace {
     let (mut obs, _) = env.reset(Some(seed));
     let (mut hold, mut longest_hold) = (0, 0);
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
-        hold = if t.info.is_success { hold + 1 } else { 0 };
+        hold = if meets_paper_test(&t.info, thresholds) {
+            hold + 1
+        } else {
+            0
+        };
         longest_hold = longest_hold.max(hold);
         if t.terminated || t.truncated {
             return EpisodeTrace {
@@ -616,16 +636,19 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
             let env: Box<dyn SimulatedEnv> = match args.stage {
                 EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
-                EnvKind::Layer => Box::new(LayerOpEnv::with_scene(
-                    scene.clone(),
-                    LayerMove::UPrime,
-                    LayerGoals::Evaluation,
-                )),
+                EnvKind::Layer => Box::new(
+                    LayerOpEnv::with_scene(
+                        scene.clone(),
+                        LayerMove::UPrime,
+                        LayerGoals::Evaluation,
+                    )
+                    .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?),
+                ),
             };
             Ok((policy, env))
         },
         |(policy, env), k| {
-            let trace = episode(env.as_mut(), policy, args.seed + k as u64);
+            let trace = episode(env.as_mut(), policy, args.seed + k as u64, thresholds);
             let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);
@@ -685,6 +708,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if args.record {
+        let wins = (wins, wins - wins_out_of_square);
         record(&prefix, &args, (object, object == trained), wins, (lo, hi))?;
     }
     Ok(ExitCode::SUCCESS)
@@ -711,7 +735,7 @@ fn record(
     prefix: &Path,
     args: &EvalStageArgs,
     (object, own): (ObjectKind, bool),
-    successes: usize,
+    (successes, square_successes): (usize, usize),
     (lo, hi): (f64, f64),
 ) -> anyhow::Result<()> {
     let path = prefix.with_extension("json");
@@ -727,6 +751,7 @@ fn record(
         "successes": successes,
         "success_rate": successes as f64 / args.episodes as f64,
         "ci95": [lo, hi],
+        "successes_left_square": square_successes,
         "seed": args.seed,
         "command": format!(
             "dexcube eval-stage {} --object {} --episodes {} --seed {}",

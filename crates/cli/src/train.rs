@@ -101,6 +101,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             args.choice.layer_move.name().replace('\'', "p")
                 + if args.quarter_goals { "-quarter" } else { "" }
                 + &suffix
+                + if args.choice.square { "-square" } else { "" }
         }
     };
     let name = args.choice.env.name();
@@ -132,6 +133,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "env": name,
             "variant": variant,
             "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
+            "success": if args.choice.square { "angle, cube left square" } else { "angle" },
             "object": object.name(),
             "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
         }),
@@ -153,14 +155,14 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             )?
         }
         EnvKind::Layer => {
-            let layer_move = args.choice.layer_move;
+            let (layer_move, goal) = (args.choice.layer_move, args.choice.layer_goal()?);
             let goals = if args.quarter_goals {
                 LayerGoals::Evaluation
             } else {
                 LayerGoals::Training
             };
             train(
-                || LayerOpEnv::with_scene(scene.clone(), layer_move, goals),
+                || LayerOpEnv::with_scene(scene.clone(), layer_move, goals).with_goal(goal),
                 config,
                 &options,
             )?

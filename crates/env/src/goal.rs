@@ -4,6 +4,7 @@
 
 use std::f64::consts::PI;
 
+use dexcube_sim::cube::ALIGNED_TOLERANCE;
 use dexcube_sim::rotation;
 
 /// A goal space: its size, the success test, and the errors `info` reports.
@@ -102,24 +103,66 @@ impl Goal for RotGoal {
     }
 }
 
-/// LayerOpEnv's goal: the angle between the two layers (1).
+/// LayerOpEnv's goal: the angle between the two layers (1), and, when the success test also
+/// needs the physical cube left in its good state, the cube's misalignment (2). The desired
+/// misalignment is always 0 and the test reads only the achieved one, so that a relabelled
+/// goal (HER) judges a transition by the same rule.
 #[derive(Clone, Copy, Debug)]
 pub struct LayerGoal {
     /// Success threshold, radians (paper: 0.1).
     pub angle_threshold: f64,
+    /// When set, success also needs every cubelet within this many radians of a
+    /// quarter-turn position (the paper's good state: 0.1). The paper's test has none.
+    pub square_threshold: Option<f64>,
 }
 
 impl Default for LayerGoal {
+    /// The paper's test: the layer angle within 0.1 rad.
     fn default() -> Self {
         LayerGoal {
             angle_threshold: 0.1,
+            square_threshold: None,
+        }
+    }
+}
+
+impl LayerGoal {
+    /// The paper's angle test, and the cube left in its good state.
+    pub fn square() -> LayerGoal {
+        LayerGoal {
+            square_threshold: Some(ALIGNED_TOLERANCE),
+            ..LayerGoal::default()
+        }
+    }
+
+    /// The goal a policy with goal vectors of `size` was trained on: 1 is the paper's, 2
+    /// also needs the good state. `None` for any other size.
+    pub fn of_size(size: usize) -> Option<LayerGoal> {
+        match size {
+            1 => Some(LayerGoal::default()),
+            2 => Some(LayerGoal::square()),
+            _ => None,
+        }
+    }
+
+    /// The desired goal for turning the layer to `angle`.
+    pub fn desired(&self, angle: f64) -> Vec<f64> {
+        self.achieved(angle, 0.0)
+    }
+
+    /// The achieved goal of a layer at `angle` with the cube `misalignment` radians out of
+    /// its good state (0 for an object with no side layers).
+    pub fn achieved(&self, angle: f64, misalignment: f64) -> Vec<f64> {
+        match self.square_threshold {
+            None => vec![angle],
+            Some(_) => vec![angle, misalignment],
         }
     }
 }
 
 impl Goal for LayerGoal {
     fn size(&self) -> usize {
-        1
+        1 + self.square_threshold.is_some() as usize
     }
 
     fn errors(&self, achieved: &[f64], desired: &[f64]) -> (f64, f64) {
@@ -128,6 +171,9 @@ impl Goal for LayerGoal {
 
     fn is_success(&self, achieved: &[f64], desired: &[f64]) -> bool {
         self.errors(achieved, desired).1 < self.angle_threshold
+            && self
+                .square_threshold
+                .is_none_or(|threshold| achieved[1] < threshold)
     }
 }
 

@@ -13,7 +13,10 @@
 //! from every side, so the policy need not know which cubelet is which. The operator feeds
 //! its Stage 2 policy the same view ([`CubeLayer`]). Goal (1): the target angle between the
 //! layers, radians, counter-clockwise seen from outside the turning layer (so U is -π/2, U'
-//! is +π/2); on the cube it is counted from the episode's start, unwrapped.
+//! is +π/2); on the cube it is counted from the episode's start, unwrapped. With
+//! [`LayerGoal::square`] the goal has a second part, the cube's misalignment (desired 0), and
+//! success also needs the cube left in its good state: the paper's test reads only the
+//! turned layer, and a policy trained on it learns to push a side layer part-way round.
 //!
 //! Six variants, as in the paper: the turning layer faces up (U), right (+x, R) or front
 //! (-y, F), and turns clockwise (U, R, F) or counter-clockwise (U', R', F'). What is sampled,
@@ -263,11 +266,19 @@ impl LayerOpEnv {
     pub fn set_desired_goal(&mut self, angle: f64) {
         self.desired = angle;
     }
+
+    /// The same environment judged by `goal`, e.g. [`LayerGoal::square`] to also need the
+    /// cube left in its good state.
+    pub fn with_goal(mut self, goal: LayerGoal) -> LayerOpEnv {
+        self.goal = Arc::new(goal);
+        self
+    }
 }
 
 impl Layer {
-    /// The 62 observations and the layer angle, which is also the achieved goal.
-    fn observe(&mut self, hand: &HandObject, desired: f64) -> Observation {
+    /// The 62 observations and the goals: the layer angle achieved, and with a goal that
+    /// needs the good state, the cube's misalignment (none on the block).
+    fn observe(&mut self, hand: &HandObject, goal: &LayerGoal, desired: f64) -> Observation {
         let observation = match self {
             Layer::Block { hinge } => {
                 let mut observation = hand.base_observation();
@@ -276,9 +287,13 @@ impl Layer {
             }
             Layer::Cube(tracker) => tracker.observe(&hand.sim),
         };
+        let misalignment = match goal.square_threshold {
+            Some(_) => CubeState::read(&hand.sim).map_or(0.0, |cube| cube.misalignment()),
+            None => 0.0,
+        };
         Observation {
-            achieved_goal: vec![observation[BASE_OBSERVATION]],
-            desired_goal: vec![desired],
+            achieved_goal: goal.achieved(observation[BASE_OBSERVATION], misalignment),
+            desired_goal: goal.desired(desired),
             observation,
         }
     }
@@ -302,7 +317,7 @@ impl GoalEnv for LayerOpEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
             observation: BASE_OBSERVATION + 1,
-            goal: 1,
+            goal: self.goal.size(),
             action: dexcube_sim::HAND_ACTUATORS,
         }
     }
@@ -338,15 +353,15 @@ impl GoalEnv for LayerOpEnv {
             LayerGoals::Evaluation => FRAC_PI_2,
         };
         self.desired = self.layer_move.direction() * size;
-        let observation = self.layer.observe(&self.hand, self.desired);
+        let observation = self.layer.observe(&self.hand, &self.goal, self.desired);
         let info = self.hand.info(&observation, self.goal.as_ref(), None);
         (observation, info)
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {
-        let (layer, desired) = (&mut self.layer, self.desired);
-        self.hand.step(action, self.goal.as_ref(), |hand| {
-            layer.observe(hand, desired)
+        let (layer, goal, desired) = (&mut self.layer, self.goal.clone(), self.desired);
+        self.hand.step(action, goal.as_ref(), |hand| {
+            layer.observe(hand, &goal, desired)
         })
     }
 }

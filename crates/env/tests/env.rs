@@ -2,14 +2,14 @@
 
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeLayer, CubeRotEnv, GoalEnv, LayerMove, LayerOpEnv, ObjectKind, RotMode, SimulatedEnv,
-    VecEnv,
+    CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotMode,
+    SimulatedEnv, VecEnv,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
 use dexcube_cube::Face;
 use dexcube_sim::Pose;
-use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, turn_face_by};
+use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, about};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -304,6 +304,51 @@ fn a_blown_up_simulation_resets_that_env_only() {
             .iter()
             .all(|s| s.transition.info.physics_error.is_none())
     );
+}
+
+/// With the good state in the success test, the goal carries the cube's misalignment: a
+/// quarter turn with the cube square succeeds, and the same turn with a side layer pushed
+/// out of line does not, though the paper's test (the turned layer's angle) would pass it.
+#[test]
+fn a_layer_turn_left_square_needs_the_cube_in_its_good_state() {
+    let mut env = LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
+        .unwrap()
+        .with_goal(LayerGoal::square());
+    assert_eq!(env.spaces().goal, 2);
+    let (obs, _) = env.reset(Some(5));
+    assert_eq!(obs.desired_goal, [FRAC_PI_2, 0.0]);
+    assert!(obs.achieved_goal[1] < ALIGNED_TOLERANCE, "starts square");
+    env.set_layer_angle(FRAC_PI_2);
+    let t = env.step(&[0.0; 20]);
+    let (a, d) = (&t.observation.achieved_goal, &t.observation.desired_goal);
+    assert!(t.info.is_success, "turned and square: {a:?}");
+    assert_eq!(t.reward, 0.0);
+    let misalignment = CubeState::read(env.sim()).unwrap().misalignment();
+    assert!(
+        (a[1] - misalignment).abs() < 1e-12,
+        "the goal reads the cube's misalignment"
+    );
+    assert!(LayerGoal::default().is_success(&a[..1], &d[..1]));
+
+    let side = face_toward(&env.sim().object_pose().orientation, [1.0, 0.0, 0.0]);
+    turn_face_by(env.sim_mut(), side, 0.35);
+    env.sim_mut().forward();
+    let t = env.step(&[0.0; 20]);
+    let a = &t.observation.achieved_goal;
+    assert!(
+        a[1] > ALIGNED_TOLERANCE,
+        "a side layer pushed out of line: {a:?}"
+    );
+    assert!(
+        !t.info.is_success && t.reward == -1.0,
+        "not a success while skewed: {a:?}"
+    );
+    // The same achieved goal, relabelled as desired (HER), is judged by the same rule.
+    assert!(
+        !env.goal().is_success(a, a),
+        "a skewed cube is never a goal reached"
+    );
+    assert!(env.goal().is_success(&[a[0], 0.05], a));
 }
 
 /// About one landing in ten on the flat hand knocks a layer of the physical cube out of its

@@ -52,6 +52,7 @@ impl PolicyFiles {
     /// Loads both policies for a cube scene whose object rests at `resting`.
     pub fn load(&self, resting: [f64; 3]) -> Result<LoadedStages, CheckpointError> {
         let device = Device::flex();
+        let layer = Policy::load(&self.layer, &device)?;
         Ok(LoadedStages {
             stage1: PolicyStage1 {
                 policy: Policy::load(&self.rot, &device)?,
@@ -59,7 +60,8 @@ impl PolicyFiles {
                 driving: Driving::default(),
             },
             stage2: PolicyStage2 {
-                policy: Policy::load(&self.layer, &device)?,
+                goal: PolicyStage2::trained_goal(&layer, &self.layer)?,
+                policy: layer,
                 resting_z: resting[2],
                 driving: Driving::default(),
             },

@@ -4,14 +4,16 @@
 //! joints directly, for testing the control logic independently of policy quality.
 
 use std::f64::consts::FRAC_PI_2;
+use std::path::Path;
 
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, EPISODE_STEPS, Goal, RotGoal, RotMode, SETTLE_STEPS, base_observation, is_dropped,
-    pose_goal, set_down,
+    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS, base_observation,
+    is_dropped, pose_goal, set_down,
 };
 use dexcube_rl::Policy;
+use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{HAND_ACTUATORS, Pose, Sim};
@@ -198,8 +200,26 @@ impl Stage1 for PolicyStage1 {
 /// scene ([`CubeLayer`]): the layer that stays, and the angle turned since the stage began.
 pub struct PolicyStage2 {
     pub policy: Policy,
+    /// The success test the policy was trained on, whose desired goal it is given: the
+    /// paper's, or one that also needs the cube left square.
+    pub goal: LayerGoal,
     pub resting_z: f64,
     pub driving: Driving,
+}
+
+impl PolicyStage2 {
+    /// The success test a Stage 2 policy (loaded from `path`) was trained on, told by the
+    /// size of its goal input: 1, the paper's; 2, the cube left square as well.
+    pub fn trained_goal(policy: &Policy, path: &Path) -> Result<LayerGoal, CheckpointError> {
+        let size = policy.card.dims.goal;
+        LayerGoal::of_size(size).ok_or_else(|| CheckpointError::Mismatch {
+            path: path.to_path_buf(),
+            message: format!(
+                "a Stage 2 policy takes a goal of 1 number (the layer angle) or 2 (and the \
+                 cube's misalignment), this one {size}: pass a LayerOpEnv policy"
+            ),
+        })
+    }
 }
 
 /// The cube-frame face whose outward normal points most nearly up in the world.
@@ -214,7 +234,7 @@ impl Stage2 for PolicyStage2 {
         let Some(mut view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
             return StageRun::default();
         };
-        let goal = [FRAC_PI_2];
+        let goal = self.goal.desired(FRAC_PI_2);
         let policy = &self.policy;
         drive(
             sim,

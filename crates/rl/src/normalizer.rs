@@ -55,6 +55,28 @@ impl Normalizer {
         variance.max(self.eps * self.eps).sqrt()
     }
 
+    /// The same statistics with `extra` inputs appended that have no history yet. The old
+    /// inputs keep their means and spreads but count as `rows` rows only, so that fresh rows
+    /// soon outweigh the zeros the new inputs start from.
+    pub fn widened(&self, extra: usize, rows: f64) -> Normalizer {
+        let scale = if self.count > 0.0 {
+            rows / self.count
+        } else {
+            0.0
+        };
+        let rescaled = |values: &[f64]| -> Vec<f64> {
+            let mut out: Vec<f64> = values.iter().map(|v| v * scale).collect();
+            out.resize(values.len() + extra, 0.0);
+            out
+        };
+        Normalizer {
+            sum: rescaled(&self.sum),
+            sum_sq: rescaled(&self.sum_sq),
+            count: self.count * scale,
+            ..self.clone()
+        }
+    }
+
     /// Appends the normalised `row` to `out`.
     pub fn normalize_into(&self, row: &[f64], out: &mut Vec<f32>) {
         for (k, &x) in row.iter().enumerate() {
@@ -80,5 +102,28 @@ mod tests {
         let mut out = vec![];
         n.normalize_into(&[2.0, 1000.0], &mut out);
         assert_eq!(out, [0.0, 5.0]);
+    }
+
+    #[test]
+    fn a_widened_normaliser_keeps_the_old_inputs_and_learns_the_new_one_from_fresh_rows() {
+        let mut n = Normalizer::new(1, 0.01, 5.0, 200.0);
+        for x in [1.0, 2.0, 3.0, 4.0] {
+            n.update(&[x]);
+        }
+        let mut wide = n.widened(1, 2.0);
+        assert_eq!(wide.size(), 2);
+        assert!((wide.mean(0) - n.mean(0)).abs() < 1e-12);
+        assert!((wide.std(0) - n.std(0)).abs() < 1e-12);
+        for _ in 0..2 {
+            wide.update(&[2.5, 0.3]);
+        }
+        assert!(
+            (wide.mean(0) - 2.5).abs() < 1e-12,
+            "the old input's mean stands"
+        );
+        assert!(
+            (wide.mean(1) - 0.15).abs() < 1e-12,
+            "the new input starts from zeros weighing as much as the kept rows"
+        );
     }
 }

@@ -49,6 +49,31 @@ pub fn read<M: Module>(module: &M) -> Vec<NamedTensor> {
     reader.out
 }
 
+/// Gives the layer whose weight is `weight` (`[inputs, outputs]`, as burn's `Linear` keeps
+/// it) `extra` more inputs at row `at`, with zero weights: the network computes what it did
+/// before, whatever the new inputs hold, and learns to use them. False if there is no such
+/// tensor or `at` is past its inputs.
+pub fn insert_zero_inputs(
+    tensors: &mut [NamedTensor],
+    weight: &str,
+    at: usize,
+    extra: usize,
+) -> bool {
+    let Some(tensor) = tensors.iter_mut().find(|t| t.name == weight) else {
+        return false;
+    };
+    let [inputs, outputs] = tensor.shape[..] else {
+        return false;
+    };
+    if at > inputs {
+        return false;
+    }
+    let zeros = std::iter::repeat_n(0.0, extra * outputs);
+    tensor.values.splice(at * outputs..at * outputs, zeros);
+    tensor.shape = vec![inputs + extra, outputs];
+    true
+}
+
 /// A parameter that did not fit.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ParamMismatch {

@@ -192,6 +192,7 @@ mod tests {
             0.8,
             Arc::new(LayerGoal {
                 angle_threshold: 0.5,
+                ..LayerGoal::default()
             }),
         );
         buffer.store(counting_episode(10, 100.0));

@@ -459,7 +459,9 @@ fn resume(
     })
 }
 
-/// Takes the networks and normalisers of the run in `dir`, for a new run.
+/// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had
+/// a shorter goal, as when a success test gains a part (LayerOpEnv's good state): the new goal
+/// inputs then start with zero weights, see [`widen_goal`].
 fn warm_start(agent: &mut Agent, dir: &Path) -> Result<(), TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
@@ -469,18 +471,45 @@ fn warm_start(agent: &mut Agent, dir: &Path) -> Result<(), TrainError> {
         )));
     }
     load_checkpoint(agent, &checkpoint_dir, |state, agent| {
-        if state.dims == agent.dims {
+        let (saved, needed) = (state.dims, agent.dims);
+        let fits = saved.observation == needed.observation
+            && saved.action == needed.action
+            && saved.goal <= needed.goal;
+        if fits {
             Ok(())
         } else {
             Err(TrainError::WarmStart(format!(
-                "{} has networks for {:?}, this environment needs {:?}",
+                "{} has networks for {saved:?}, this environment needs {needed:?}",
                 checkpoint_dir.display(),
-                state.dims,
-                agent.dims
             )))
         }
     })
     .map(drop)
+}
+
+/// Rows the old inputs' statistics count as after [`widen_goal`]: about one cycle's worth,
+/// so the new inputs' statistics are the fresh rows' within a few cycles.
+const WIDENED_NORMALISER_ROWS: f64 = 1000.0;
+
+/// Gives networks saved for goals of `saved` components the `extra` goal components appended
+/// after them: zero weights in each first layer, so every network computes what it did, and
+/// goal statistics that learn the new components from fresh rows.
+fn widen_goal(
+    networks: &mut [Vec<crate::params::NamedTensor>; 4],
+    goal_norm: &mut crate::normalizer::Normalizer,
+    dims: Dims,
+    extra: usize,
+) -> Result<(), String> {
+    let at = dims.observation + dims.goal;
+    for (tensors, name) in networks.iter_mut().zip(NETWORK_FILES) {
+        if !crate::params::insert_zero_inputs(tensors, "layers.0.weight", at, extra) {
+            return Err(format!(
+                "the {name} network has no first layer with {at} inputs or more"
+            ));
+        }
+    }
+    *goal_norm = goal_norm.widened(extra, WIDENED_NORMALISER_ROWS);
+    Ok(())
 }
 
 /// Loads a checkpoint's networks and normalisers into `agent` once `check` has vetted its
@@ -490,18 +519,25 @@ fn load_checkpoint(
     checkpoint_dir: &Path,
     check: impl Fn(&TrainState, &Agent) -> Result<(), TrainError>,
 ) -> Result<(Vec<EpochMetrics>, Option<PathBuf>), TrainError> {
-    let state: TrainState = checkpoint::load_json(&checkpoint_dir.join("state.json"))?;
+    let mut state: TrainState = checkpoint::load_json(&checkpoint_dir.join("state.json"))?;
     check(&state, agent)?;
     let mut networks: [Vec<crate::params::NamedTensor>; 4] = Default::default();
     for (slot, name) in networks.iter_mut().zip(NETWORK_FILES) {
         *slot = checkpoint::load_tensors(&checkpoint_dir.join(format!("{name}.safetensors")))?;
     }
-    agent.load_networks(&networks).map_err(|e| {
+    let mismatch = |message: String| {
         TrainError::Checkpoint(CheckpointError::Mismatch {
             path: checkpoint_dir.to_path_buf(),
-            message: e.to_string(),
+            message,
         })
-    })?;
+    };
+    let extra = agent.dims.goal.saturating_sub(state.dims.goal);
+    if extra > 0 {
+        widen_goal(&mut networks, &mut state.goal_norm, state.dims, extra).map_err(mismatch)?;
+    }
+    agent
+        .load_networks(&networks)
+        .map_err(|e| mismatch(e.to_string()))?;
     agent.observation_norm = state.observation_norm;
     agent.goal_norm = state.goal_norm;
     Ok((state.metrics, state.init_from))

@@ -1,8 +1,10 @@
 //! Checkpoints, resume and shipped policies: what is saved comes back, a killed run continues,
 //! and bad files fail with a message instead of a panic.
 
-use dexcube_env::GoalEnv;
-use dexcube_rl::point_mass::PointMassEnv;
+use std::sync::Arc;
+
+use dexcube_env::{Goal, GoalEnv, Info, Observation, Spaces, Transition};
+use dexcube_rl::point_mass::{PointGoal, PointMassEnv};
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 
 fn config() -> DdpgHerConfig {
@@ -107,23 +109,37 @@ fn a_run_writes_its_files_and_resumes_where_it_stopped() {
     assert!(err.to_string().contains("is a run of point mass"), "{err}");
 }
 
-#[test]
-fn a_warm_start_carries_the_networks_into_a_new_run() {
-    let source = fresh_dir("dexcube-rl-warm-source");
+/// Trains a one-epoch source run in `NAME-source`, and returns it with the folder of a new run
+/// (`NAME`), the options that warm-start that run from the source, and a configuration
+/// without batches. Another configuration is fine for a new run; with no batches, learning
+/// cannot move the actor or critic, so what they hold at the end is what they started from.
+fn warm_start_from_a_new_run(
+    name: &str,
+) -> (
+    std::path::PathBuf,
+    std::path::PathBuf,
+    TrainOptions,
+    DdpgHerConfig,
+) {
+    let source = fresh_dir(&format!("{name}-source"));
     train(PointMassEnv::default, config(), &options(&source, 1, false)).unwrap();
-    let saved =
-        dexcube_rl::checkpoint::load_tensors(&source.join("checkpoint/actor.safetensors")).unwrap();
-    let dir = fresh_dir("dexcube-rl-warm");
+    let dir = fresh_dir(name);
     let warm = TrainOptions {
         init_from: Some(source.clone()),
         ..options(&dir, 1, false)
     };
-    // Another configuration is fine for a new run. With no batches, learning cannot move
-    // the actor, so what it holds at the end is what it started from.
     let frozen = DdpgHerConfig {
         batches_per_cycle: 0,
         ..config()
     };
+    (source, dir, warm, frozen)
+}
+
+#[test]
+fn a_warm_start_carries_the_networks_into_a_new_run() {
+    let (source, dir, warm, frozen) = warm_start_from_a_new_run("dexcube-rl-warm");
+    let saved =
+        dexcube_rl::checkpoint::load_tensors(&source.join("checkpoint/actor.safetensors")).unwrap();
     let run = train(PointMassEnv::default, frozen.clone(), &warm).unwrap();
     assert_eq!(run.metrics.len(), 1, "a new run counts its own epochs");
     let by_name = |mut tensors: Vec<dexcube_rl::params::NamedTensor>| {
@@ -166,6 +182,119 @@ fn a_warm_start_carries_the_networks_into_a_new_run() {
         .err()
         .unwrap();
     assert!(err.to_string().contains("holds no checkpoint"), "{err}");
+}
+
+/// The point mass with a third goal component appended (0 desired, the distance from the
+/// origin achieved) that its success test also reads, as LayerOpEnv's good state joins the
+/// layer angle.
+struct PointMassWithRadius(PointMassEnv);
+
+struct InsideRadius;
+
+impl Goal for InsideRadius {
+    fn size(&self) -> usize {
+        3
+    }
+    fn errors(&self, achieved: &[f64], desired: &[f64]) -> (f64, f64) {
+        PointGoal.errors(achieved, desired)
+    }
+    fn is_success(&self, achieved: &[f64], desired: &[f64]) -> bool {
+        PointGoal.is_success(achieved, desired) && achieved[2] < 0.5
+    }
+}
+
+impl PointMassWithRadius {
+    fn widen(mut observation: Observation) -> Observation {
+        let radius = observation.achieved_goal[0].hypot(observation.achieved_goal[1]);
+        observation.achieved_goal.push(radius);
+        observation.desired_goal.push(0.0);
+        observation
+    }
+}
+
+impl GoalEnv for PointMassWithRadius {
+    fn spaces(&self) -> Spaces {
+        Spaces {
+            goal: 3,
+            ..self.0.spaces()
+        }
+    }
+    fn goal(&self) -> Arc<dyn Goal> {
+        Arc::new(InsideRadius)
+    }
+    fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
+        let (observation, info) = self.0.reset(seed);
+        (Self::widen(observation), info)
+    }
+    fn step(&mut self, action: &[f64]) -> Transition {
+        let t = self.0.step(action);
+        Transition {
+            observation: Self::widen(t.observation),
+            ..t
+        }
+    }
+}
+
+/// A success test that gains a goal component warm-starts from the old run: the new input
+/// comes in with zero weights in each network's first layer, so the networks compute what
+/// they did, and the goal normaliser gains the component.
+#[test]
+fn a_warm_start_onto_a_longer_goal_gives_the_new_input_zero_weights() {
+    let (source, _, warm, frozen) = warm_start_from_a_new_run("dexcube-rl-widen");
+    let make = || PointMassWithRadius(PointMassEnv::default());
+    let run = train(make, frozen, &warm).unwrap();
+    let at = 2 + 2; // observation, then the old goal
+    for (k, name) in ["actor", "critic", "target_actor", "target_critic"]
+        .into_iter()
+        .enumerate()
+    {
+        let saved = dexcube_rl::checkpoint::load_tensors(
+            &source.join(format!("checkpoint/{name}.safetensors")),
+        )
+        .unwrap();
+        let now = &run.agent.networks()[k];
+        // The targets move toward the networks by polyak averaging even without batches:
+        // only the actor and critic must hold exactly what was saved.
+        let exact = k < 2;
+        for tensor in &saved {
+            let widened = now.iter().find(|t| t.name == tensor.name).unwrap();
+            if tensor.name != "layers.0.weight" {
+                if !exact {
+                    continue;
+                }
+                assert_eq!(widened, tensor, "{name} {} unchanged", tensor.name);
+                continue;
+            }
+            let outputs = tensor.shape[1];
+            assert_eq!(
+                widened.shape,
+                [tensor.shape[0] + 1, outputs],
+                "{name}: one more input"
+            );
+            let row = |t: &dexcube_rl::params::NamedTensor, r: usize| {
+                t.values[r * outputs..(r + 1) * outputs].to_vec()
+            };
+            assert!(
+                row(widened, at).iter().all(|&w| w == 0.0),
+                "{name}: the new input weighs 0"
+            );
+            if exact {
+                for r in 0..tensor.shape[0] {
+                    let shifted = if r < at { r } else { r + 1 };
+                    assert_eq!(
+                        row(widened, shifted),
+                        row(tensor, r),
+                        "{name}: input {r} kept"
+                    );
+                }
+            }
+        }
+    }
+    assert_eq!(run.agent.goal_norm.size(), 3);
+    assert!(
+        run.agent.goal_norm.mean(2) > 0.0,
+        "the new component learnt from fresh rows"
+    );
 }
 
 #[test]
