@@ -55,6 +55,10 @@ pub struct OperatorArgs {
     /// pose that is off is, before Stage 2 tries to turn it.
     #[arg(long)]
     pub stage1_good_state: bool,
+    /// Planning for the hand, price each plan's first move knowing which face is up now, so
+    /// that of equally short plans one starting on that face (no Stage 1) is preferred.
+    #[arg(long, conflicts_with = "paper_operator")]
+    pub plan_from_face_up: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
@@ -93,6 +97,7 @@ impl OperatorArgs {
             driving,
             already_up_anywhere: self.already_up == AlreadyUp::Face,
             stage1_good_state: self.stage1_good_state,
+            plan_from_face_up: self.plan_from_face_up,
             ..OperatorConfig::default()
         }
     }
@@ -129,7 +134,12 @@ impl OperatorArgs {
         } else {
             ""
         };
-        format!("{planner}, opening the hand {opening}, {stage1}{skip}{square}")
+        let first_move = if config.plan_from_face_up {
+            ", the first move priced knowing the face up"
+        } else {
+            ""
+        };
+        format!("{planner}, opening the hand {opening}, {stage1}{skip}{square}{first_move}")
     }
 
     /// The flags that select this operator, as a command line names them.
@@ -156,7 +166,12 @@ impl OperatorArgs {
         } else {
             ""
         };
-        format!("{paper}{held}{opening}{already_up}{square}")
+        let first_move = if self.plan_from_face_up {
+            " --plan-from-face-up"
+        } else {
+            ""
+        };
+        format!("{paper}{held}{opening}{already_up}{square}{first_move}")
     }
 }
 

@@ -152,6 +152,9 @@ pub struct OperatorConfig {
     /// With rollback, Stage 1 also needs the cube in its good state: a cube it leaves with a
     /// layer skewed is squared up and re-posed by randomisation, as a pose that is off is.
     pub stage1_good_state: bool,
+    /// Planning for the hand, price each plan's first move knowing which face is up now (by
+    /// the test that skips Stage 1), rather than as if a Stage 1 were always needed first.
+    pub plan_from_face_up: bool,
 }
 
 impl Default for OperatorConfig {
@@ -165,6 +168,7 @@ impl Default for OperatorConfig {
             driving: Driving::FOR_HAND,
             already_up_anywhere: false,
             stage1_good_state: false,
+            plan_from_face_up: false,
         }
     }
 }
@@ -183,12 +187,15 @@ pub fn move_plan(m: Move) -> (Face, usize) {
     (up, if m.quarters == 3 { 1 } else { 3 })
 }
 
-/// Atomic actions a move costs the hand: a Stage 1, unless the move before it needed the same
-/// face up, and one or three Stage 2 turns.
-pub fn hand_cost(before: Option<Move>, m: Move) -> u32 {
-    let (up, turns) = move_plan(m);
-    let stage1 = before.is_none_or(|b| move_plan(b).0 != up);
-    (turns + usize::from(stage1)) as u32
+/// The atomic actions each move costs the hand, as a price for `cheapest_optimal`: one or
+/// three Stage 2 turns, and a Stage 1 unless the face the move needs is up already: after a
+/// move that needed the same face up, or, for a plan's first move, when `up_now` is that face.
+pub fn hand_cost(up_now: Option<Face>) -> impl Fn(Option<Move>, Move) -> u32 {
+    move |before, m| {
+        let (up, turns) = move_plan(m);
+        let up_before = before.map_or(up_now, |b| Some(move_plan(b).0));
+        (turns + usize::from(up_before != Some(up))) as u32
+    }
 }
 
 /// The rollback's test of the cube's pose after Stage 1: (simulation, target position, target
@@ -215,7 +222,7 @@ impl Operator<'_> {
             outcome.failure = Some(Failure::StuckMisaligned);
             return outcome;
         };
-        let mut plan = self.plan(&start);
+        let mut plan = self.plan(sim, &start);
         narrate(&Event::Plan(plan.clone()));
         let mut expected = start;
         while let Some(&m) = plan.first() {
@@ -239,7 +246,7 @@ impl Operator<'_> {
                     narrate(&Event::MoveDone(m))
                 }
                 Some(seen) => {
-                    plan = self.plan(&seen);
+                    plan = self.plan(sim, &seen);
                     expected = seen;
                     outcome.replans += 1;
                     narrate(&Event::Replan(plan.clone()));
@@ -265,13 +272,29 @@ impl Operator<'_> {
     }
 
     /// An optimal plan from `cube`: the hand's cheapest, or the solver's first.
-    fn plan(&self, cube: &Facelets) -> Vec<Move> {
+    fn plan(&self, sim: &Sim, cube: &Facelets) -> Vec<Move> {
         let position = Position::of(cube);
-        if self.config.plan_for_hand {
-            self.table.cheapest_optimal(&position, hand_cost)
-        } else {
-            self.table.solve(&position)
+        if !self.config.plan_for_hand {
+            return self.table.solve(&position);
         }
+        let up_now = if self.config.plan_from_face_up {
+            [Face::U, Face::R, Face::B]
+                .into_iter()
+                .find(|&face| self.already_up(sim, face))
+        } else {
+            None
+        };
+        self.table.cheapest_optimal(&position, hand_cost(up_now))
+    }
+
+    /// Whether the cube in `sim` already has `up` up, by the test that skips Stage 1.
+    fn already_up(&self, sim: &Sim, up: Face) -> bool {
+        let up_at = if self.config.already_up_anywhere {
+            sim.object_pose().position
+        } else {
+            self.resting
+        };
+        (self.stage1_accepts)(sim, up_at, stage1_target(up))
     }
 
     /// Both stages of one move, with the rollback checks; a failure ends the attempt.
@@ -285,12 +308,7 @@ impl Operator<'_> {
         let (up, turns) = move_plan(m);
         let target = stage1_target(up);
         let mut stage1_attempts = self.config.stage1_attempts;
-        let up_at = if self.config.already_up_anywhere {
-            sim.object_pose().position
-        } else {
-            self.resting
-        };
-        if self.config.plan_for_hand && (self.stage1_accepts)(sim, up_at, target) {
+        if self.config.plan_for_hand && self.already_up(sim, up) {
             narrate(&Event::AlreadyUp(up));
             stage1_attempts = 0;
         }

@@ -87,17 +87,23 @@ fn solve_from(
 /// The paper's operator runs Stage 1 and then 1 or 3 Stage 2 runs for each move of the
 /// solver's first optimal plan. Planning for the hand takes the optimal plan of fewest actions
 /// and runs no Stage 1 for a face already up (U, at the start), and needs fewer actions.
+/// Priced knowing that U is up, the plan costs exactly what the hand then spends.
 #[test]
 fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
     let table = DistanceTable::build();
-    let mut actions = [0, 0];
+    let mut actions = [0, 0, 0];
     for (distance, seed) in [(1, 0), (2, 5), (4, 1), (9, 2), (14, 3)] {
         let position = dexcube_cube::Position::of(
             &scrambles_at_distance(&table, distance, 1, seed)[0].facelets,
         );
-        for plan_for_hand in [false, true] {
+        for (variant, (plan_for_hand, plan_from_face_up)) in
+            [(false, false), (true, false), (true, true)]
+                .into_iter()
+                .enumerate()
+        {
             let config = OperatorConfig {
                 plan_for_hand,
+                plan_from_face_up,
                 ..OperatorConfig::default()
             };
             let outcome = attempt_judged(
@@ -111,11 +117,13 @@ fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
             assert!(outcome.solved, "distance {distance}: {outcome:?}");
             assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
             let expected: usize = if plan_for_hand {
-                let plan = table.cheapest_optimal(&position, hand_cost);
+                let up_now = plan_from_face_up.then_some(Face::U);
+                let plan = table.cheapest_optimal(&position, hand_cost(up_now));
                 let priced: u32 = (0..plan.len())
-                    .map(|i| hand_cost(i.checked_sub(1).map(|j| plan[j]), plan[i]))
+                    .map(|i| hand_cost(up_now)(i.checked_sub(1).map(|j| plan[j]), plan[i]))
                     .sum();
-                priced as usize - usize::from(move_plan(plan[0]).0 == Face::U)
+                let skipped = up_now.is_none() && move_plan(plan[0]).0 == Face::U;
+                priced as usize - usize::from(skipped)
             } else {
                 let plan = table.solve(&position);
                 plan.iter().map(|&m| 1 + move_plan(m).1).sum()
@@ -125,13 +133,40 @@ fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
             assert_eq!(stages.stage1_runs + stages.stage2_runs, outcome.actions);
             assert_eq!(stages.stage1_reached, stages.stage1_runs);
             assert_eq!(stages.stage2_misaligned, 0);
-            actions[usize::from(plan_for_hand)] += outcome.actions;
+            actions[variant] += outcome.actions;
         }
     }
     assert!(
-        actions[1] < actions[0],
+        actions[1] < actions[0] && actions[2] <= actions[1],
         "planning for the hand saves actions: {actions:?}"
     );
+}
+
+/// Pricing the first move knowing which face is up never costs more than pricing it blind,
+/// and on some positions it finds a plan that skips the first Stage 1.
+#[test]
+fn knowing_the_face_up_finds_plans_that_skip_the_first_stage_1() {
+    let table = DistanceTable::build();
+    let price = |plan: &[dexcube_cube::Move], up_now| -> u32 {
+        (0..plan.len())
+            .map(|i| hand_cost(up_now)(i.checked_sub(1).map(|j| plan[j]), plan[i]))
+            .sum()
+    };
+    let mut saved = 0;
+    for distance in 2..=8 {
+        for scramble in scrambles_at_distance(&table, distance, 30, 11) {
+            let position = dexcube_cube::Position::of(&scramble.facelets);
+            for up in [Face::U, Face::R, Face::B] {
+                let blind = table.cheapest_optimal(&position, hand_cost(None));
+                let seeing = table.cheapest_optimal(&position, hand_cost(Some(up)));
+                assert_eq!(seeing.len(), blind.len(), "both optimal");
+                let (blind, seeing) = (price(&blind, Some(up)), price(&seeing, Some(up)));
+                assert!(seeing <= blind, "distance {distance}, {up:?} up");
+                saved += usize::from(seeing < blind);
+            }
+        }
+    }
+    assert!(saved > 0, "some plans start on the face that is up");
 }
 
 /// A Stage 1 that leaves the cube upside down on its first `misses` runs.
