@@ -309,22 +309,27 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
             }
         }
     }
-    let command = format!(
-        "dexcube eval --per-distance {} --distances {} --seed {}{}{} --rot-policy {} --layer-policy {}",
-        args.per_distance,
-        args.distances,
-        args.seed,
-        if args.no_rollback {
-            " --no-rollback"
-        } else if args.rollback_only {
-            " --rollback-only"
-        } else {
-            ""
-        },
-        args.operator.flags(),
-        files.rot.display(),
-        files.layer.display()
-    );
+    // The command that makes the rows on file: a CSV continued with the other variant holds
+    // both, as one run without --rollback-only or --no-rollback makes them.
+    let command = |rows: &[CubeResult]| {
+        let variant = match (
+            rows.iter().any(|r| r.rollback),
+            rows.iter().any(|r| !r.rollback),
+        ) {
+            (true, false) => " --rollback-only",
+            (false, true) => " --no-rollback",
+            _ => "",
+        };
+        format!(
+            "dexcube eval --per-distance {} --distances {} --seed {}{variant}{} --rot-policy {} --layer-policy {}",
+            args.per_distance,
+            args.distances,
+            args.seed,
+            args.operator.flags(),
+            files.rot.display(),
+            files.layer.display()
+        )
+    };
     eprintln!(
         "{} cubes to go ({} already in {})",
         jobs.len(),
@@ -351,7 +356,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         let rows = table(&sorted, &distances);
         write_atomically(
             &args.out.with_extension("md"),
-            markdown(&rows, &sorted, &command).as_bytes(),
+            markdown(&rows, &sorted, &command(&sorted)).as_bytes(),
         )?;
         Ok(())
     };
@@ -398,7 +403,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     if let Err(e) = plot(&rows, &args.out) {
         eprintln!("warning: no plot: {e}");
     }
-    print!("{}", markdown(&rows, &results, &command));
+    print!("{}", markdown(&rows, &results, &command(&results)));
     Ok(ExitCode::SUCCESS)
 }
 

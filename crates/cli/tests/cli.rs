@@ -191,11 +191,8 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     assert!(o.status.success(), "{}", stderr(&o));
     let csv = std::fs::read_to_string(out.with_extension("csv")).unwrap();
     assert_eq!(csv.lines().count(), 2, "{csv}");
-    assert!(
-        std::fs::read_to_string(out.with_extension("md"))
-            .unwrap()
-            .contains("| 1 | 1 |")
-    );
+    let md = std::fs::read_to_string(out.with_extension("md")).unwrap();
+    assert!(md.contains("| 1 | 1 |") && md.contains("--seed 5 --rollback-only --rot-policy"));
     let again = dexcube(&args, "");
     assert!(
         stderr(&again).contains("0 cubes to go (1 already in"),
@@ -214,6 +211,7 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
         &["--paper-operator"][..],
         &["--stage1-held", "0"],
         &["--opening", "at-once"],
+        &["--plan-from-face-up"],
     ] {
         let refused = dexcube(&[&args[..], other].concat(), "");
         assert_clean_failure(&refused, 2, "or another operator");
@@ -221,6 +219,21 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     // Naming the defaults is the same operator.
     let defaults = [&args[..], &["--stage1-held", "5", "--opening", "gradual"]].concat();
     assert!(dexcube(&defaults, "").status.success());
+    // Continued with the open-loop variant, the table holds both, as one run without either
+    // variant flag makes them, and its markdown names that command.
+    let open_loop: Vec<&str> = args
+        .iter()
+        .map(|&a| {
+            if a == "--rollback-only" {
+                "--no-rollback"
+            } else {
+                a
+            }
+        })
+        .collect();
+    assert!(dexcube(&open_loop, "").status.success());
+    let md = std::fs::read_to_string(out.with_extension("md")).unwrap();
+    assert!(md.contains("--seed 5 --rot-policy"), "{md}");
 }
 
 #[test]
