@@ -124,31 +124,24 @@ impl OperatorArgs {
             Some(steps) => format!("Stage 1 ends once held {steps} steps"),
             None => "whole Stage 1 episodes".to_string(),
         };
-        let skip = if config.already_up_anywhere {
-            ", no Stage 1 when the face is up anywhere on the palm"
-        } else {
-            ""
-        };
-        let square = if config.stage1_good_state {
-            ", Stage 1 also needs the good state"
-        } else {
-            ""
-        };
-        let first_move = if config.plan_from_face_up {
-            ", the first move priced knowing the face up"
-        } else {
-            ""
-        };
+        let skip = when(
+            config.already_up_anywhere,
+            ", no Stage 1 when the face is up anywhere on the palm",
+        );
+        let square = when(
+            config.stage1_good_state,
+            ", Stage 1 also needs the good state",
+        );
+        let first_move = when(
+            config.plan_from_face_up,
+            ", the first move priced knowing the face up",
+        );
         format!("{planner}, opening the hand {opening}, {stage1}{skip}{square}{first_move}")
     }
 
     /// The flags that select this operator, as a command line names them.
     fn flags(self) -> String {
-        let paper = if self.paper_operator {
-            " --paper-operator"
-        } else {
-            ""
-        };
+        let paper = when(self.paper_operator, " --paper-operator");
         let held = self
             .stage1_held
             .map_or(String::new(), |steps| format!(" --stage1-held {steps}"));
@@ -157,22 +150,16 @@ impl OperatorArgs {
             Some(Opening::Gradual) => " --opening gradual",
             None => "",
         };
-        let already_up = match self.already_up {
-            AlreadyUp::Pose => "",
-            AlreadyUp::Face => " --already-up face",
-        };
-        let square = if self.stage1_good_state {
-            " --stage1-good-state"
-        } else {
-            ""
-        };
-        let first_move = if self.plan_from_face_up {
-            " --plan-from-face-up"
-        } else {
-            ""
-        };
+        let already_up = when(self.already_up == AlreadyUp::Face, " --already-up face");
+        let square = when(self.stage1_good_state, " --stage1-good-state");
+        let first_move = when(self.plan_from_face_up, " --plan-from-face-up");
         format!("{paper}{held}{opening}{already_up}{square}{first_move}")
     }
+}
+
+/// `text` when `on`, else nothing: an optional part of an operator's name or flags.
+fn when(on: bool, text: &str) -> &str {
+    if on { text } else { "" }
 }
 
 /// The shipped policies, or others.

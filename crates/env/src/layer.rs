@@ -137,9 +137,11 @@ impl CubeLayer {
 
     /// The 62 observations (the layer angle turned so far last).
     pub fn observe(&mut self, sim: &Sim) -> Vec<f64> {
-        let Some(state) = CubeState::read(sim) else {
-            unreachable!("a CubeLayer is only started on a cube scene")
-        };
+        self.observe_reading(sim, &read_cube(sim))
+    }
+
+    /// The same from `state`, a reading of the cube in `sim` already taken.
+    fn observe_reading(&mut self, sim: &Sim, state: &CubeState) -> Vec<f64> {
         let now = state.layer_angle(self.face);
         // Readings wrap at ±45°: accumulate the change, brought into ±45°.
         let change = now - self.last;
@@ -279,17 +281,21 @@ impl Layer {
     /// The 62 observations and the goals: the layer angle achieved, and with a goal that
     /// needs the good state, the cube's misalignment (none on the block).
     fn observe(&mut self, hand: &HandObject, goal: &LayerGoal, desired: f64) -> Observation {
-        let observation = match self {
+        let (observation, misalignment) = match self {
             Layer::Block { hinge } => {
                 let mut observation = hand.base_observation();
                 observation.push(block_angle(hand, *hinge));
-                observation
+                (observation, 0.0)
             }
-            Layer::Cube(tracker) => tracker.observe(&hand.sim),
-        };
-        let misalignment = match goal.square_threshold {
-            Some(_) => CubeState::read(&hand.sim).map_or(0.0, |cube| cube.misalignment()),
-            None => 0.0,
+            Layer::Cube(tracker) => {
+                // One reading of the cube serves the observation and the good state.
+                let state = read_cube(&hand.sim);
+                let misalignment = match goal.square_threshold {
+                    Some(_) => state.misalignment(),
+                    None => 0.0,
+                };
+                (tracker.observe_reading(&hand.sim, &state), misalignment)
+            }
         };
         Observation {
             achieved_goal: goal.achieved(observation[BASE_OBSERVATION], misalignment),
@@ -297,6 +303,14 @@ impl Layer {
             observation,
         }
     }
+}
+
+/// Reads the cube of a scene that holds one (a `Layer::Cube` or a started `CubeLayer`).
+fn read_cube(sim: &Sim) -> CubeState {
+    let Some(state) = CubeState::read(sim) else {
+        unreachable!("a CubeLayer is only started on a cube scene")
+    };
+    state
 }
 
 fn block_angle(hand: &HandObject, hinge: JointAddress) -> f64 {
@@ -359,9 +373,9 @@ impl GoalEnv for LayerOpEnv {
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {
-        let (layer, goal, desired) = (&mut self.layer, self.goal.clone(), self.desired);
+        let (layer, goal, desired) = (&mut self.layer, &self.goal, self.desired);
         self.hand.step(action, goal.as_ref(), |hand| {
-            layer.observe(hand, &goal, desired)
+            layer.observe(hand, goal, desired)
         })
     }
 }

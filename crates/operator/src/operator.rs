@@ -21,12 +21,15 @@
 //! operator: the first optimal plan, and Stage 1 before every move.
 
 use dexcube_cube::{DistanceTable, Face, Facelets, Move, Position, Solver};
+use dexcube_env::is_square;
 use dexcube_sim::cube::{CubeState, snap_layers};
 use dexcube_sim::{Pose, Sim};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::stages::{Driving, Stage1, Stage2, StageRun, face_up, randomise_pose, stage1_target};
+use crate::stages::{
+    Driving, STAGE1_FACES, Stage1, Stage2, StageRun, face_up, randomise_pose, stage1_target,
+};
 
 /// Why an attempt ended without a solved cube.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -278,7 +281,7 @@ impl Operator<'_> {
             return self.table.solve(&position);
         }
         let up_now = if self.config.plan_from_face_up {
-            [Face::U, Face::R, Face::B]
+            STAGE1_FACES
                 .into_iter()
                 .find(|&face| self.already_up(sim, face))
         } else {
@@ -319,7 +322,7 @@ impl Operator<'_> {
                 return Some(failure);
             }
             let posed = (self.stage1_accepts)(sim, self.resting, target);
-            let square = !self.config.stage1_good_state || in_good_state(sim);
+            let square = !self.config.stage1_good_state || is_square(sim);
             let ok = posed && square;
             outcome.stages.stage1_runs += 1;
             outcome.stages.stage1_reached += usize::from(posed);
@@ -352,10 +355,10 @@ impl Operator<'_> {
                 return Some(failure);
             }
             outcome.stages.stage2_runs += 1;
-            outcome.stages.stage2_misaligned += usize::from(!in_good_state(sim));
+            outcome.stages.stage2_misaligned += usize::from(!is_square(sim));
             if self.config.rollback {
                 let mut restores = 0;
-                while !in_good_state(sim) {
+                while !is_square(sim) {
                     if restores == self.config.restores {
                         return Some(Failure::StuckMisaligned);
                     }
@@ -376,11 +379,6 @@ impl Operator<'_> {
         }
         None
     }
-}
-
-/// Whether the cube is in the paper's good state: every cubelet in line.
-fn in_good_state(sim: &Sim) -> bool {
-    CubeState::read(sim).is_some_and(|s| s.is_aligned())
 }
 
 /// The cube's stickers in its own frame, if they can be read.

@@ -19,6 +19,9 @@ use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{HAND_ACTUATORS, Pose, Sim};
 use rand_chacha::ChaCha8Rng;
 
+/// The faces Stage 1 brings up, one per target pose: U, R and B (which serves the F moves).
+pub const STAGE1_FACES: [Face; 3] = [Face::U, Face::R, Face::B];
+
 /// The paper's Stage 1 target orientation for each face that can be brought up, in the cube
 /// frame (x = R, y = B, z = U): U, R, and the pose the paper names F, which lifts B. Turning
 /// B' on top equals F' up to a whole-cube turn, so that pose serves the F moves.
