@@ -11,7 +11,7 @@ use burn::prelude::Device;
 use clap::Args;
 use dexcube_env::{CubeRotEnv, RotGoal, RotMode};
 use dexcube_rl::agent::Batch;
-use dexcube_rl::{Agent, DdpgHerConfig, Dims, TrainOptions, train};
+use dexcube_rl::{Agent, DdpgHerConfig, Dims, Learners, TrainOptions, train};
 use dexcube_sim::{Scene, SceneKind};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -65,7 +65,7 @@ pub fn run(args: RlArgs) -> anyhow::Result<ExitCode> {
     let mut times = Vec::with_capacity(args.updates);
     for i in 0..args.updates {
         let start = Instant::now();
-        agent.train(&batch);
+        agent.train(&batch, Learners::ActorAndCritic);
         if i % config.batches_per_cycle == config.batches_per_cycle - 1 {
             agent.end_cycle();
         }
@@ -116,6 +116,7 @@ pub fn run(args: RlArgs) -> anyhow::Result<ExitCode> {
         resume: false,
         init_from: None,
         snapshot_every: 0,
+        critic_only_epochs: 0,
         progress: false,
         label: "bench".into(),
         metadata: serde_json::json!({}),

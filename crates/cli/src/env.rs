@@ -55,9 +55,9 @@ pub struct EnvChoice {
     /// rigid cube, its default). Block and rigid are quicker to simulate.
     #[arg(long)]
     pub object: Option<ObjectKind>,
-    /// LayerOpEnv on the physical cube only: success also needs the cube left in its good
-    /// state (every cubelet within 0.1 rad of a quarter turn); the goal gains the cube's
-    /// misalignment. The paper's test reads the turned layer only.
+    /// On the physical cube only: success also needs the cube left in its good state (every
+    /// cubelet within 0.1 rad of a quarter turn); the goal gains the cube's misalignment.
+    /// The paper's tests read only the pose (CubeRotEnv) or the turned layer (LayerOpEnv).
     #[arg(long)]
     pub square: bool,
 }
@@ -78,7 +78,7 @@ impl EnvChoice {
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
         let scene = Scene::load(self.object()?.scene())?;
         Ok(match self.env {
-            EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene, RotGoal::paper(self.mode))),
+            EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene, self.rot_goal()?)),
             EnvKind::Layer => Box::new(
                 LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
                     .with_goal(self.layer_goal()?),
@@ -86,15 +86,36 @@ impl EnvChoice {
         })
     }
 
+    /// Whether the success test needs the cube left square (`--square`, which only the
+    /// physical cube can be asked for).
+    pub fn square(&self) -> anyhow::Result<bool> {
+        if self.square && self.object()? != ObjectKind::Cube {
+            bail!(
+                "--square is for the physical cube, whose layers can be left out of line: \
+                 add --object cube"
+            );
+        }
+        Ok(self.square)
+    }
+
+    /// CubeRotEnv's success test: the paper's in the chosen mode, or with `--square` the
+    /// good state as well.
+    pub fn rot_goal(&self) -> anyhow::Result<RotGoal> {
+        let paper = RotGoal::paper(self.mode);
+        Ok(if self.square()? {
+            paper.left_square()
+        } else {
+            paper
+        })
+    }
+
     /// LayerOpEnv's success test: the paper's, or with `--square` the good state as well.
     pub fn layer_goal(&self) -> anyhow::Result<LayerGoal> {
-        if !self.square {
-            return Ok(LayerGoal::default());
-        }
-        if self.env != EnvKind::Layer || self.object()? != ObjectKind::Cube {
-            bail!("--square is for LayerOpEnv on the physical cube (train layer --object cube)");
-        }
-        Ok(LayerGoal::square())
+        Ok(if self.square()? {
+            LayerGoal::square()
+        } else {
+            LayerGoal::default()
+        })
     }
 
     /// The run's label. Runs on each environment's original object keep the label they had
@@ -104,11 +125,7 @@ impl EnvChoice {
             EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
-        let square = if self.layer_goal()?.square_threshold.is_some() {
-            ", left square"
-        } else {
-            ""
-        };
+        let square = if self.square()? { ", left square" } else { "" };
         Ok(match self.named_object()? {
             None => format!("{what}{square})"),
             Some(object) => format!("{what}, {}{square})", object.name()),
@@ -190,9 +207,14 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
         "  episode:     {} control steps of 20 x 0.002 s",
         dexcube_env::EPISODE_STEPS
     );
+    let square = if choice.square()? {
+        ", every cubelet within 0.1 rad of a quarter turn"
+    } else {
+        ""
+    };
     match choice.env {
         EnvKind::Rot => println!(
-            "  success:     position within 0.01 m and {} within 0.1 rad; reward 0, else -1",
+            "  success:     position within 0.01 m and {} within 0.1 rad{square}; reward 0, else -1",
             match choice.mode {
                 RotMode::Paper => "orientation",
                 RotMode::Axis => "the target's up axis",
@@ -200,12 +222,7 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
             }
         ),
         EnvKind::Layer => println!(
-            "  success:     layer angle within 0.1 rad of the goal{}; reward 0, else -1",
-            if choice.square {
-                ", every cubelet within 0.1 rad of a quarter turn"
-            } else {
-                ""
-            }
+            "  success:     layer angle within 0.1 rad of the goal{square}; reward 0, else -1"
         ),
     }
     Ok(ExitCode::SUCCESS)

@@ -19,7 +19,7 @@ use dexcube_operator::OperatorConfig;
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
-use dexcube_operator::stages::{Driving, PolicyStage2};
+use dexcube_operator::stages::{Driving, PolicyStage1, PolicyStage2};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_sim::{Scene, SceneKind};
@@ -642,7 +642,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         || -> anyhow::Result<(Policy, Box<dyn SimulatedEnv>)> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
             let env: Box<dyn SimulatedEnv> = match args.stage {
-                EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene.clone(), rot_goal)),
+                EnvKind::Rot => Box::new(CubeRotEnv::with_scene(
+                    scene.clone(),
+                    PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?,
+                )),
                 EnvKind::Layer => Box::new(
                     LayerOpEnv::with_scene(
                         scene.clone(),

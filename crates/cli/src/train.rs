@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, LayerOpEnv, RotGoal};
+use dexcube_env::{CubeRotEnv, LayerOpEnv};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
 use dexcube_sim::Scene;
 
@@ -52,6 +52,10 @@ pub struct TrainArgs {
     /// goals uniform over it (HER still relabels with the angles reached on the way).
     #[arg(long)]
     quarter_goals: bool,
+    /// Train only the critic for this run's first N epochs, the actor held as loaded: for a
+    /// warm start (--init) onto another object or success test (0: DDPG as published).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    critic_only_epochs: usize,
     /// Keep the policy of every this many epochs under DIR/snapshots (0: none).
     #[arg(long, default_value_t = 5)]
     snapshot_every: usize,
@@ -101,9 +105,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             args.choice.layer_move.name().replace('\'', "p")
                 + if args.quarter_goals { "-quarter" } else { "" }
                 + &suffix
-                + if args.choice.square { "-square" } else { "" }
         }
-    };
+    } + if args.choice.square()? { "-square" } else { "" };
     let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
@@ -127,15 +130,22 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         resume,
         init_from: args.init.clone(),
         snapshot_every: args.snapshot_every,
+        critic_only_epochs: args.critic_only_epochs,
         progress: true,
         label: args.choice.name()?,
         metadata: serde_json::json!({
             "env": name,
             "variant": variant,
             "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
-            "success": if args.choice.square { "angle, cube left square" } else { "angle" },
+            "success": match (args.choice.env, args.choice.square()?) {
+                (EnvKind::Rot, false) => "pose",
+                (EnvKind::Rot, true) => "pose, cube left square",
+                (EnvKind::Layer, false) => "angle",
+                (EnvKind::Layer, true) => "angle, cube left square",
+            },
             "object": object.name(),
             "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
+            "critic_only_epochs": args.critic_only_epochs,
         }),
     };
     eprintln!(
@@ -147,7 +157,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let scene = Scene::load(object.scene())?;
     let trained = match args.choice.env {
         EnvKind::Rot => {
-            let goal = RotGoal::paper(args.choice.mode);
+            let goal = args.choice.rot_goal()?;
             train(
                 || CubeRotEnv::with_scene(scene.clone(), goal),
                 config,

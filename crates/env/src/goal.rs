@@ -43,7 +43,9 @@ pub enum RotMode {
     Pair,
 }
 
-/// CubeRotEnv's goal: position (3) and orientation quaternion (4, w first).
+/// CubeRotEnv's goal: position (3) and orientation quaternion (4, w first), and, when the
+/// success test also needs the physical cube left in its good state, the cube's misalignment
+/// (8), read as [`LayerGoal`] reads it.
 #[derive(Clone, Copy, Debug)]
 pub struct RotGoal {
     pub mode: RotMode,
@@ -51,7 +53,13 @@ pub struct RotGoal {
     pub position_threshold: f64,
     /// Success threshold for the orientation, radians (paper: 0.1; the authors' code 0.2).
     pub angle_threshold: f64,
+    /// When set, success also needs every cubelet within this many radians of a
+    /// quarter-turn position. The paper's test has none.
+    pub square_threshold: Option<f64>,
 }
+
+/// Length of a pose goal: position 3, quaternion 4.
+const POSE_GOAL: usize = 7;
 
 impl RotGoal {
     /// The paper's thresholds, 0.01 m and 0.1 rad.
@@ -60,8 +68,53 @@ impl RotGoal {
             mode,
             position_threshold: 0.01,
             angle_threshold: 0.1,
+            square_threshold: None,
         }
     }
+
+    /// The same test, and the cube left in its good state.
+    pub fn left_square(self) -> RotGoal {
+        RotGoal {
+            square_threshold: Some(ALIGNED_TOLERANCE),
+            ..self
+        }
+    }
+
+    /// The goal in `mode` a policy with goal vectors of `size` was trained on: 7 is the
+    /// paper's, 8 also needs the good state. `None` for any other size.
+    pub fn of_size(mode: RotMode, size: usize) -> Option<RotGoal> {
+        match size {
+            POSE_GOAL => Some(RotGoal::paper(mode)),
+            n if n == POSE_GOAL + 1 => Some(RotGoal::paper(mode).left_square()),
+            _ => None,
+        }
+    }
+
+    /// The desired goal for the pose `pose` (position, then quaternion).
+    pub fn desired(&self, pose: &[f64]) -> Vec<f64> {
+        self.achieved(pose, 0.0)
+    }
+
+    /// The achieved goal of the cube at `pose` and `misalignment` radians out of its good
+    /// state (0 for the rigid cube).
+    pub fn achieved(&self, pose: &[f64], misalignment: f64) -> Vec<f64> {
+        with_misalignment(pose, self.square_threshold, misalignment)
+    }
+}
+
+/// `goal`, with the cube's misalignment appended when the test reads it.
+fn with_misalignment(goal: &[f64], square_threshold: Option<f64>, misalignment: f64) -> Vec<f64> {
+    let mut out = goal.to_vec();
+    if square_threshold.is_some() {
+        out.push(misalignment);
+    }
+    out
+}
+
+/// Whether an achieved goal leaves the cube square: its last part, the misalignment, within
+/// `square_threshold`. Always, for a test without one.
+fn left_square(square_threshold: Option<f64>, achieved: &[f64]) -> bool {
+    square_threshold.is_none_or(|threshold| achieved.last().is_some_and(|&m| m < threshold))
 }
 
 fn quat(goal: &[f64]) -> rotation::Quat {
@@ -70,7 +123,7 @@ fn quat(goal: &[f64]) -> rotation::Quat {
 
 impl Goal for RotGoal {
     fn size(&self) -> usize {
-        7
+        POSE_GOAL + self.square_threshold.is_some() as usize
     }
 
     fn errors(&self, achieved: &[f64], desired: &[f64]) -> (f64, f64) {
@@ -99,7 +152,9 @@ impl Goal for RotGoal {
 
     fn is_success(&self, achieved: &[f64], desired: &[f64]) -> bool {
         let (position, angle) = self.errors(achieved, desired);
-        position < self.position_threshold && angle < self.angle_threshold
+        position < self.position_threshold
+            && angle < self.angle_threshold
+            && left_square(self.square_threshold, achieved)
     }
 }
 
@@ -153,10 +208,7 @@ impl LayerGoal {
     /// The achieved goal of a layer at `angle` with the cube `misalignment` radians out of
     /// its good state (0 for an object with no side layers).
     pub fn achieved(&self, angle: f64, misalignment: f64) -> Vec<f64> {
-        match self.square_threshold {
-            None => vec![angle],
-            Some(_) => vec![angle, misalignment],
-        }
+        with_misalignment(&[angle], self.square_threshold, misalignment)
     }
 }
 
@@ -171,9 +223,7 @@ impl Goal for LayerGoal {
 
     fn is_success(&self, achieved: &[f64], desired: &[f64]) -> bool {
         self.errors(achieved, desired).1 < self.angle_threshold
-            && self
-                .square_threshold
-                .is_none_or(|threshold| achieved[1] < threshold)
+            && left_square(self.square_threshold, achieved)
     }
 }
 

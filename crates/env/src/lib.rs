@@ -5,9 +5,14 @@
 //! success and -1 otherwise computed by pure functions of the goals (so Hindsight Experience
 //! Replay can relabel), and `terminated` / `truncated` as in Gymnasium.
 //!
-//! - [`CubeRotEnv`] (Stage 1): re-pose a rigid 5 cm cube on the palm; observation 61, goal 7.
+//! - [`CubeRotEnv`] (Stage 1): re-pose a rigid 5 cm cube (or the physical 2x2x2 cube) on the
+//!   palm; observation 61, goal 7.
 //! - [`LayerOpEnv`] (Stage 2): turn one layer of the physical 2x2x2 cube (or of a two-layer
 //!   block); observation 62, goal 1.
+//!
+//! On the physical cube either goal can gain one part, the cube's misalignment, for a success
+//! test that also needs the cube left in its good state ([`RotGoal::left_square`],
+//! [`LayerGoal::square`]).
 //! - [`VecEnv`]: many environments stepped on a thread pool, each with its own `MjData`.
 //!
 //! Dynamics follow Gymnasium-Robotics' hand environments: an action in [-1, 1]^20 maps onto
@@ -27,7 +32,7 @@ pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{
     BASE_OBSERVATION, DROP_DEPTH, ObjectKind, SETTLE_STEPS, base_observation, is_dropped,
-    is_square, resting_point, set_down,
+    is_square, misalignment, resting_point, set_down,
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, pose_goal};

@@ -1,8 +1,12 @@
-//! CubeRotEnv (Stage 1): re-pose a rigid 5 cm cube on the palm so that a given face is up.
+//! CubeRotEnv (Stage 1): re-pose a cube on the palm (a rigid 5 cm cube, or the physical
+//! 2x2x2 of the `cube` scene) so that a given face is up.
 //!
 //! Observation (61): hand joint angles 24, joint velocities 24, cube position 3, orientation
 //! quaternion 4 (w first, w ≥ 0), linear velocity 3, angular velocity 3. Goal (7): target
-//! position and quaternion.
+//! position and quaternion. On the physical cube, with [`RotGoal::left_square`], the goal has
+//! an eighth part, the cube's misalignment (desired 0), and success also needs the cube left
+//! in its good state, as LayerOpEnv's square test does: the paper's test reads only the pose,
+//! and a pose reached with a layer pushed part-way round must be restored before Stage 2.
 //!
 //! What is sampled, exactly: at reset the cube is placed at its resting point on the palm
 //! plus N(0, 5 mm) noise on each coordinate, with an orientation drawn uniformly from SO(3)
@@ -21,7 +25,7 @@ use dexcube_sim::{Scene, SceneKind, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, RotGoal, RotMode};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical, misalignment};
 use crate::random::uniform_rotation;
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
@@ -68,7 +72,14 @@ impl CubeRotEnv {
         }
     }
 
-    /// Sets the goal (position, then quaternion) for the episode under way.
+    /// The same environment judged by `goal`, e.g. [`RotGoal::left_square`] to also need the
+    /// physical cube left in its good state.
+    pub fn with_goal(mut self, goal: RotGoal) -> CubeRotEnv {
+        self.goal = Arc::new(goal);
+        self
+    }
+
+    /// Sets the goal pose (position, then quaternion) for the episode under way.
     pub fn set_desired_goal(&mut self, desired: &[f64]) {
         self.desired = desired.to_vec();
         self.show_target();
@@ -77,16 +88,6 @@ impl CubeRotEnv {
     /// The palm's resting point, the target position.
     pub fn resting_point(&self) -> [f64; 3] {
         self.hand.resting
-    }
-
-    fn observe(&self) -> Observation {
-        let observation = self.hand.base_observation();
-        let achieved_goal = observation[48..55].to_vec();
-        Observation {
-            observation,
-            achieved_goal,
-            desired_goal: self.desired.clone(),
-        }
     }
 
     /// Turns the ghost cube beside the hand to the goal orientation.
@@ -100,14 +101,18 @@ impl CubeRotEnv {
     }
 }
 
-/// The 61 observations, with the cube's pose (observations 48 to 54) as the achieved goal.
-fn observe(hand: &HandObject, desired: &[f64]) -> Observation {
+/// The 61 observations, with the cube's pose (observations 48 to 54) as the achieved goal,
+/// and with a goal that needs the good state, the cube's misalignment after it.
+fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64]) -> Observation {
     let observation = hand.base_observation();
-    let achieved_goal = observation[48..55].to_vec();
+    let misalignment = match goal.square_threshold {
+        Some(_) => misalignment(&hand.sim),
+        None => 0.0,
+    };
     Observation {
+        achieved_goal: goal.achieved(&observation[48..55], misalignment),
+        desired_goal: goal.desired(desired),
         observation,
-        achieved_goal,
-        desired_goal: desired.to_vec(),
     }
 }
 
@@ -134,7 +139,7 @@ impl GoalEnv for CubeRotEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
             observation: BASE_OBSERVATION,
-            goal: 7,
+            goal: self.goal.size(),
             action: dexcube_sim::HAND_ACTUATORS,
         }
     }
@@ -149,15 +154,15 @@ impl GoalEnv for CubeRotEnv {
         let pick = self.hand.rng.random_range(0..PAPER_TARGETS.len());
         self.desired = pose_goal(self.hand.resting, PAPER_TARGETS[pick]);
         self.show_target();
-        let observation = self.observe();
+        let observation = observe(&self.hand, &self.goal, &self.desired);
         let info = self.hand.info(&observation, self.goal.as_ref(), None);
         (observation, info)
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {
-        let desired = &self.desired;
+        let (goal, desired) = (&self.goal, &self.desired);
         self.hand
-            .step(action, self.goal.as_ref(), |hand| observe(hand, desired))
+            .step(action, goal.as_ref(), |hand| observe(hand, goal, desired))
     }
 }
 

@@ -2,15 +2,15 @@
 
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotMode,
-    SimulatedEnv, VecEnv,
+    CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal,
+    RotMode, SimulatedEnv, VecEnv,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
 use dexcube_cube::Face;
-use dexcube_sim::Pose;
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, about};
+use dexcube_sim::{Pose, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -330,25 +330,66 @@ fn a_layer_turn_left_square_needs_the_cube_in_its_good_state() {
     );
     assert!(LayerGoal::default().is_success(&a[..1], &d[..1]));
 
+    let a = skew_a_side_layer(&mut env);
+    assert!(env.goal().is_success(&[a[0], 0.05], &a));
+}
+
+/// Pushes the layer facing +x (a side layer for either stage's goal) 0.35 rad out of line
+/// and steps: checks that the goal reads the misalignment (its last part), that the step is
+/// no success, and that the same achieved goal relabelled as desired (HER) is none either.
+/// Returns the achieved goal.
+fn skew_a_side_layer(env: &mut dyn SimulatedEnv) -> Vec<f64> {
     let side = face_toward(&env.sim().object_pose().orientation, [1.0, 0.0, 0.0]);
     turn_face_by(env.sim_mut(), side, 0.35);
     env.sim_mut().forward();
     let t = env.step(&[0.0; 20]);
-    let a = &t.observation.achieved_goal;
+    let a = t.observation.achieved_goal;
     assert!(
-        a[1] > ALIGNED_TOLERANCE,
+        a[a.len() - 1] > ALIGNED_TOLERANCE,
         "a side layer pushed out of line: {a:?}"
     );
     assert!(
         !t.info.is_success && t.reward == -1.0,
         "not a success while skewed: {a:?}"
     );
-    // The same achieved goal, relabelled as desired (HER), is judged by the same rule.
     assert!(
-        !env.goal().is_success(a, a),
+        !env.goal().is_success(&a, &a),
         "a skewed cube is never a goal reached"
     );
-    assert!(env.goal().is_success(&[a[0], 0.05], a));
+    a
+}
+
+/// Stage 1 with the good state in its test: the goal gains the cube's misalignment; the cube
+/// at the target pose succeeds when square, and not with a side layer out of line, though
+/// the paper's test (the pose alone) would pass it.
+#[test]
+fn a_pose_reached_left_square_needs_the_cube_in_its_good_state() {
+    let scene = Scene::load(ObjectKind::Cube.scene()).unwrap();
+    let mut env = CubeRotEnv::with_scene(scene, RotGoal::paper(RotMode::Pair).left_square());
+    assert_eq!(env.spaces().goal, 8);
+    let (obs, _) = env.reset(Some(5));
+    let desired = obs.desired_goal;
+    assert_eq!((desired.len(), desired[7]), (8, 0.0));
+    let target = Pose {
+        position: env.resting_point(),
+        orientation: [desired[3], desired[4], desired[5], desired[6]],
+    };
+    env.sim_mut().set_object_pose(&target);
+    env.sim_mut().forward();
+    let t = env.step(&[0.0; 20]);
+    let a = &t.observation.achieved_goal;
+    assert!(t.info.is_success, "at the pose and square: {a:?}");
+    let misalignment = CubeState::read(env.sim()).unwrap().misalignment();
+    assert!(
+        (a[7] - misalignment).abs() < 1e-12,
+        "the goal reads the cube's misalignment"
+    );
+    let a = skew_a_side_layer(&mut env);
+    let paper = RotGoal::paper(RotMode::Pair);
+    assert!(
+        paper.is_success(&a[..7], &desired[..7]),
+        "the pose alone still passes: {a:?}"
+    );
 }
 
 /// About one landing in ten on the flat hand knocks a layer of the physical cube out of its

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use burn::prelude::Device;
 use dexcube_cube::{DistanceTable, Move};
-use dexcube_env::RotMode;
+use dexcube_env::{RotGoal, RotMode};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_sim::{Scene, SceneKind, Sim};
@@ -52,11 +52,14 @@ impl PolicyFiles {
     /// Loads both policies for a cube scene whose object rests at `resting`.
     pub fn load(&self, resting: [f64; 3]) -> Result<LoadedStages, CheckpointError> {
         let device = Device::flex();
-        let layer = Policy::load(&self.layer, &device)?;
+        let (rot, layer) = (
+            Policy::load(&self.rot, &device)?,
+            Policy::load(&self.layer, &device)?,
+        );
         Ok(LoadedStages {
             stage1: PolicyStage1 {
-                policy: Policy::load(&self.rot, &device)?,
-                mode: self.rot_mode,
+                goal: PolicyStage1::trained_goal(&rot, self.rot_mode, &self.rot)?,
+                policy: rot,
                 driving: Driving::default(),
             },
             stage2: PolicyStage2 {
@@ -166,7 +169,7 @@ pub fn run_cube(
     let mut sim = Sim::new(scene.clone());
     let resting = stages.resting;
     set_up_scramble(&mut sim, scramble, resting);
-    let accepts = pose_reached(stages.rot_mode);
+    let accepts = pose_reached(RotGoal::paper(stages.rot_mode));
     stages.stage1.driving = config.driving;
     stages.stage2.driving = config.driving;
     let mut operator = Operator {

@@ -10,7 +10,7 @@ use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
     CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS, base_observation,
-    is_dropped, pose_goal, set_down,
+    is_dropped, misalignment, pose_goal, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -168,15 +168,44 @@ fn advance(
 /// Stage 1 by a CubeRotEnv policy.
 pub struct PolicyStage1 {
     pub policy: Policy,
-    pub mode: RotMode,
+    /// The success test the policy was trained on, whose desired goal it is given and which
+    /// its run is held to: the paper's in some mode, or one that also needs the cube left
+    /// square.
+    pub goal: RotGoal,
     pub driving: Driving,
+}
+
+impl PolicyStage1 {
+    /// The success test in `mode` a Stage 1 policy (loaded from `path`) was trained on, told
+    /// by the size of its goal input: 7, the paper's; 8, the cube left square as well.
+    pub fn trained_goal(
+        policy: &Policy,
+        mode: RotMode,
+        path: &Path,
+    ) -> Result<RotGoal, CheckpointError> {
+        let size = policy.card.dims.goal;
+        RotGoal::of_size(mode, size).ok_or_else(|| {
+            wrong_goal_size(path, "1 (CubeRotEnv)", "7 numbers (the pose) or 8", size)
+        })
+    }
+}
+
+/// The error for a policy whose goal input fits neither of a stage's goals.
+fn wrong_goal_size(path: &Path, stage: &str, expected: &str, size: usize) -> CheckpointError {
+    CheckpointError::Mismatch {
+        path: path.to_path_buf(),
+        message: format!(
+            "a Stage {stage} policy takes a goal of {expected} (and the cube's misalignment), \
+             this one {size}: pass a policy trained for that stage"
+        ),
+    }
 }
 
 impl Stage1 for PolicyStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
-        let goal = pose_goal(position, target);
+        let goal = self.goal.desired(&pose_goal(position, target));
         let policy = &self.policy;
-        let reached = pose_reached(self.mode);
+        let reached = pose_reached(self.goal);
         let mut running = 0;
         let mut held = |sim: &Sim| {
             self.driving.stage1_held_steps.is_some_and(|steps| {
@@ -215,12 +244,13 @@ impl PolicyStage2 {
     /// size of its goal input: 1, the paper's; 2, the cube left square as well.
     pub fn trained_goal(policy: &Policy, path: &Path) -> Result<LayerGoal, CheckpointError> {
         let size = policy.card.dims.goal;
-        LayerGoal::of_size(size).ok_or_else(|| CheckpointError::Mismatch {
-            path: path.to_path_buf(),
-            message: format!(
-                "a Stage 2 policy takes a goal of 1 number (the layer angle) or 2 (and the \
-                 cube's misalignment), this one {size}: pass a LayerOpEnv policy"
-            ),
+        LayerGoal::of_size(size).ok_or_else(|| {
+            wrong_goal_size(
+                path,
+                "2 (LayerOpEnv)",
+                "1 number (the layer angle) or 2",
+                size,
+            )
         })
     }
 }
@@ -304,14 +334,19 @@ pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
     });
 }
 
-/// The rollback's pose check after Stage 1: CubeRotEnv's success test in `mode`, judged on
-/// the physical cube's pose.
-pub fn pose_reached(mode: RotMode) -> impl Fn(&Sim, [f64; 3], Quat) -> bool {
+/// CubeRotEnv's success test `goal` judged on the physical cube: its pose, and for a test
+/// that needs it, its good state. With the paper's test, the rollback's pose check after
+/// Stage 1.
+pub fn pose_reached(goal: RotGoal) -> impl Fn(&Sim, [f64; 3], Quat) -> bool {
     move |sim, position, target| {
         let pose = sim.object_pose();
-        RotGoal::paper(mode).is_success(
-            &pose_goal(pose.position, pose.orientation),
-            &pose_goal(position, target),
+        let off_square = match goal.square_threshold {
+            Some(_) => misalignment(sim),
+            None => 0.0,
+        };
+        goal.is_success(
+            &goal.achieved(&pose_goal(pose.position, pose.orientation), off_square),
+            &goal.desired(&pose_goal(position, target)),
         )
     }
 }

@@ -4,7 +4,7 @@
 
 use dexcube_cube::Face;
 use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
-use dexcube_env::RotMode;
+use dexcube_env::{RotGoal, RotMode};
 use dexcube_operator::stages::{
     Driving, KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached,
     randomise_pose,
@@ -70,7 +70,7 @@ fn solve_from(
     let table = DistanceTable::build();
     let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
     set_up_scramble(&mut sim, scramble, at);
-    let accepts = pose_reached(mode);
+    let accepts = pose_reached(RotGoal::paper(mode));
     let mut operator = Operator {
         config,
         stage1,
@@ -362,7 +362,7 @@ fn randomising_the_pose_seats_the_cube_on_the_palm_and_keeps_the_layers() {
 fn a_held_pose_ends_policy_stage_1_early() {
     let (mut stages, resting) = shipped_stages();
     let target = dexcube_operator::stages::stage1_target(Face::U);
-    let accepts = pose_reached(RotMode::Pair);
+    let accepts = pose_reached(RotGoal::paper(RotMode::Pair));
     let settle = 2 * dexcube_env::SETTLE_STEPS;
     let mut steps = Vec::new();
     for held in [None, Some(3)] {

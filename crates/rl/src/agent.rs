@@ -46,6 +46,17 @@ pub struct Batch {
     pub terminal: Vec<f32>,
 }
 
+/// Which networks a training step updates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Learners {
+    /// DDPG's step: the critic, then the actor along the critic's gradient.
+    ActorAndCritic,
+    /// The critic alone, the actor kept as it is: a warm start onto another object or test
+    /// lets the critic learn the new values from the loaded actor's experience before those
+    /// values steer the actor.
+    CriticOnly,
+}
+
 /// What one optimisation step measured.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StepStats {
@@ -178,8 +189,9 @@ impl Agent {
             .unwrap_or_default()
     }
 
-    /// One optimisation step of actor and critic on `batch`.
-    pub fn train(&mut self, batch: &Batch) -> StepStats {
+    /// One optimisation step on `batch` of the critic, and of the actor unless `learners`
+    /// holds it.
+    pub fn train(&mut self, batch: &Batch, learners: Learners) -> StepStats {
         let (n, da) = (batch.len, self.dims.action);
         let target: Tensor<2> = Tensor::from_data(self.targets(batch).into_data(), &self.device);
         let x = self.inputs(&batch.observation, &batch.goal, n, &self.device);
@@ -197,13 +209,15 @@ impl Agent {
             mean_q: scalar(&q.mean()),
         };
         let critic_grads = GradientsParams::from_grads(critic_loss.backward(), &self.critic);
-        let actor_grads = GradientsParams::from_grads(actor_loss.backward(), &self.actor);
         self.critic =
             self.critic_optimizer
                 .step(self.config.critic_lr, self.critic.clone(), critic_grads);
-        self.actor =
-            self.actor_optimizer
-                .step(self.config.actor_lr, self.actor.clone(), actor_grads);
+        if learners == Learners::ActorAndCritic {
+            let actor_grads = GradientsParams::from_grads(actor_loss.backward(), &self.actor);
+            self.actor =
+                self.actor_optimizer
+                    .step(self.config.actor_lr, self.actor.clone(), actor_grads);
+        }
         stats
     }
 

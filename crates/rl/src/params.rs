@@ -13,6 +13,21 @@ pub struct NamedTensor {
     pub values: Vec<f32>,
 }
 
+/// How far apart two sets of the same parameters are: the sum of absolute differences (for
+/// tests and diagnostics: whether training moved a network).
+pub fn l1_distance(a: &[NamedTensor], b: &[NamedTensor]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| {
+            x.values
+                .iter()
+                .zip(&y.values)
+                .map(|(p, q)| (p - q).abs())
+                .sum::<f32>()
+        })
+        .sum()
+}
+
 /// Every float parameter of `module`, in visiting order.
 pub fn read<M: Module>(module: &M) -> Vec<NamedTensor> {
     struct Reader {

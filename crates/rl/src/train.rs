@@ -28,7 +28,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::agent::{Agent, Dims, StepStats};
+use crate::agent::{Agent, Dims, Learners, StepStats};
 use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
 use crate::normalizer::Normalizer;
@@ -53,6 +53,11 @@ pub struct TrainOptions {
     pub init_from: Option<PathBuf>,
     /// Keep the policy of every this many epochs under `snapshots/` (0: none).
     pub snapshot_every: usize,
+    /// The run's first epochs in which only the critic learns ([`Learners::CriticOnly`]):
+    /// after a warm start onto another object or success test, the replay buffer and the
+    /// optimisers' moments start empty, and an actor steered at once by a critic fitted to
+    /// a few episodes can lose what it knew (0: none, DDPG as published).
+    pub critic_only_epochs: usize,
     /// Show a progress bar with ETA on stderr.
     pub progress: bool,
     /// What is being trained, for plots and policy cards.
@@ -212,6 +217,11 @@ pub fn train<E: GoalEnv>(
         let (mut rollout_s, mut learning_s) = (0.0, 0.0);
         let (mut train_successes, mut train_episodes, mut steps) = (0, 0, 0);
         let mut stats = StepStats::default();
+        let learners = if epoch < options.critic_only_epochs {
+            Learners::CriticOnly
+        } else {
+            Learners::ActorAndCritic
+        };
         for cycle in 0..cycles {
             let t = Instant::now();
             let (episodes, s) = rollout(
@@ -236,7 +246,7 @@ pub fn train<E: GoalEnv>(
             }
             for _ in 0..config.batches_per_cycle {
                 let batch = buffer.sample(config.batch_size, &mut rng);
-                let s = agent.train(&batch);
+                let s = agent.train(&batch, learners);
                 stats.critic_loss += s.critic_loss / updates_per_epoch;
                 stats.actor_loss += s.actor_loss / updates_per_epoch;
                 stats.mean_q += s.mean_q / updates_per_epoch;

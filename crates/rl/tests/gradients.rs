@@ -7,7 +7,7 @@ use burn::tensor::TensorData;
 use dexcube_rl::agent::Batch;
 use dexcube_rl::networks::Mlp;
 use dexcube_rl::params;
-use dexcube_rl::{Agent, DdpgHerConfig, Dims};
+use dexcube_rl::{Agent, DdpgHerConfig, Dims, Learners};
 
 #[test]
 fn autodiff_matches_finite_differences() {
@@ -67,10 +67,9 @@ fn small_agent(seed: u64) -> (Agent, DdpgHerConfig) {
     )
 }
 
-#[test]
-fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
-    let (mut agent, _) = small_agent(1);
-    let batch = Batch {
+/// Eight made-up transitions for a [`small_agent`].
+fn eight_transitions() -> Batch {
+    Batch {
         len: 8,
         observation: (0..32).map(|i| (i as f64 * 0.37).sin()).collect(),
         goal: (0..16).map(|i| (i as f64 * 0.11).cos()).collect(),
@@ -78,36 +77,63 @@ fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
         reward: vec![-1.0; 8],
         next_observation: (0..32).map(|i| (i as f64 * 0.41).cos()).collect(),
         terminal: vec![0.0; 8],
-    };
+    }
+}
+
+#[test]
+fn a_critic_only_step_leaves_the_actor_as_it_was_and_trains_the_critic() {
+    let (mut agent, _) = small_agent(4);
+    let batch = eight_transitions();
+    let [actor0, critic0, ..] = agent.networks();
+    for _ in 0..5 {
+        agent.train(&batch, Learners::CriticOnly);
+    }
+    agent.end_cycle();
+    let [actor1, critic1, target_actor1, _] = agent.networks();
+    assert_eq!(
+        params::l1_distance(&actor0, &actor1),
+        0.0,
+        "the actor is held"
+    );
+    // A Polyak blend of equal weights returns them, up to rounding.
+    assert!(
+        params::l1_distance(&actor1, &target_actor1) < 1e-5,
+        "so its target stays on it"
+    );
+    assert!(
+        params::l1_distance(&critic0, &critic1) > 0.0,
+        "the critic learns"
+    );
+    // The same steps with both learners do move the actor.
+    agent.train(&batch, Learners::ActorAndCritic);
+    agent.end_cycle();
+    assert!(params::l1_distance(&actor1, &agent.networks()[0]) > 0.0);
+}
+
+#[test]
+fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
+    let (mut agent, _) = small_agent(1);
+    let batch = eight_transitions();
     let [actor0, _, target0, _] = agent.networks();
     for _ in 0..3 {
         for _ in 0..5 {
-            agent.train(&batch);
+            agent.train(&batch, Learners::ActorAndCritic);
         }
         agent.end_cycle();
     }
     let [actor1, critic1, target1, target_critic1] = agent.networks();
-    let moved = |a: &[params::NamedTensor], b: &[params::NamedTensor]| {
-        a.iter()
-            .zip(b)
-            .map(|(x, y)| {
-                x.values
-                    .iter()
-                    .zip(&y.values)
-                    .map(|(p, q)| (p - q).abs())
-                    .sum::<f32>()
-            })
-            .sum::<f32>()
-    };
     assert!(
-        moved(&actor0, &actor1) > 0.0,
+        params::l1_distance(&actor0, &actor1) > 0.0,
         "the actor still learns after its target was made"
     );
     assert!(
-        moved(&target0, &target1) > 0.0,
+        params::l1_distance(&target0, &target1) > 0.0,
         "the target moved towards it"
     );
-    assert!(moved(&target1, &actor1) > 0.0, "but only part of the way");
+    assert!(
+        params::l1_distance(&target1, &actor1) > 0.0,
+        "but only part of the way"
+    );
     // The targets are plain-device snapshots: no parameter of theirs requires a gradient.
     assert!(!critic1.is_empty() && !target_critic1.is_empty());
     assert!(agent.targets_track_no_gradients());

@@ -27,6 +27,7 @@ fn options(epochs: usize) -> TrainOptions {
         resume: false,
         init_from: None,
         snapshot_every: 0,
+        critic_only_epochs: 0,
         progress: false,
         label: "point mass".into(),
         metadata: serde_json::json!({}),
