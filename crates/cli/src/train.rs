@@ -62,6 +62,13 @@ pub struct TrainArgs {
     /// Optimisation batches per cycle (HER baselines: 40).
     #[arg(long, default_value_t = 40)]
     batches: usize,
+    /// Gaussian exploration noise as a share of the action range (HER baselines: 0.2).
+    #[arg(long, value_name = "SHARE")]
+    noise_eps: Option<f64>,
+    /// Probability of a uniformly random action while exploring (HER baselines: 0.3).
+    /// Fine-tuning a policy that already succeeds may want less of both.
+    #[arg(long, value_name = "P")]
+    random_eps: Option<f64>,
     /// Train without Hindsight Experience Replay (plain DDPG), for ablations.
     #[arg(long)]
     no_her: bool,
@@ -116,11 +123,22 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             false,
         ),
     };
+    let published = DdpgHerConfig::default();
     let config = DdpgHerConfig {
         batches_per_cycle: args.batches,
         her: !args.no_her,
-        ..DdpgHerConfig::default()
+        noise_eps: args.noise_eps.unwrap_or(published.noise_eps),
+        random_eps: args.random_eps.unwrap_or(published.random_eps),
+        ..published
     };
+    for (name, value) in [
+        ("--noise-eps", config.noise_eps),
+        ("--random-eps", config.random_eps),
+    ] {
+        if !(0.0..=1.0).contains(&value) {
+            bail!("{name} must be between 0 and 1, not {value}");
+        }
+    }
     let options = TrainOptions {
         epochs: args.epochs,
         envs,

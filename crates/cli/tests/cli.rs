@@ -308,6 +308,32 @@ fn each_environment_takes_only_objects_it_can_hold() {
     }
 }
 
+/// Settings a training run cannot use are refused before it starts, each with its reason.
+#[test]
+fn train_refuses_settings_it_cannot_run() {
+    for (args, says) in [
+        (
+            &["rot", "--quarter-goals"][..],
+            "--quarter-goals is for LayerOpEnv",
+        ),
+        (&["rot", "--square"], "--square is for the physical cube"),
+        (
+            &["layer", "--random-eps", "1.5"],
+            "--random-eps must be between 0 and 1",
+        ),
+        (
+            &["layer", "--noise-eps=-0.1"],
+            "--noise-eps must be between 0 and 1",
+        ),
+    ] {
+        let o = dexcube(
+            &[&["train"][..], args, &["--out", "/nonexistent/run"]].concat(),
+            "",
+        );
+        assert_clean_failure(&o, 2, says);
+    }
+}
+
 /// `eval-stage --record` writes the figure on the policy's own object as its evaluation, and
 /// one on another object beside it; an object the stage cannot hold is refused.
 #[test]
