@@ -115,6 +115,7 @@ pub fn run(args: RlArgs) -> anyhow::Result<ExitCode> {
         out_dir: None,
         resume: false,
         init_from: None,
+        init_actor: None,
         snapshot_every: 0,
         critic_only_epochs: 0,
         progress: false,

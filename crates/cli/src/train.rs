@@ -48,6 +48,11 @@ pub struct TrainArgs {
     /// to fine-tune on another success test or goal range); a new run in --out.
     #[arg(long, value_name = "DIR", conflicts_with = "resume")]
     init: Option<PathBuf>,
+    /// With --init: take the actor and its normalisers from this policy (PREFIX.safetensors
+    /// and PREFIX.json, e.g. models/rot, which may be an earlier epoch than the run's last
+    /// checkpoint); the critic still comes from the --init run.
+    #[arg(long, value_name = "PREFIX", requires = "init")]
+    init_actor: Option<PathBuf>,
     /// LayerOpEnv only: train on the evaluation goal, exactly a quarter turn, rather than
     /// goals uniform over it (HER still relabels with the angles reached on the way).
     #[arg(long)]
@@ -147,6 +152,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         out_dir: Some(out.clone()),
         resume,
         init_from: args.init.clone(),
+        init_actor: args.init_actor.clone(),
         snapshot_every: args.snapshot_every,
         critic_only_epochs: args.critic_only_epochs,
         progress: true,
@@ -164,6 +170,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "object": object.name(),
             "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
             "critic_only_epochs": args.critic_only_epochs,
+            "init_actor": args.init_actor.as_ref().map(|p| p.display().to_string()),
         }),
     };
     eprintln!(

@@ -51,6 +51,11 @@ pub struct TrainOptions {
     /// Warm start: take the networks and normalisers of the run in this folder (its
     /// `checkpoint/`), then train as a new run. Only the sizes must match.
     pub init_from: Option<PathBuf>,
+    /// With `init_from`: take the actor (and its target) and the normalisers from this
+    /// policy (`PREFIX.safetensors` and `PREFIX.json`, e.g. a shipped one, which may be an
+    /// earlier epoch than the run's last checkpoint) rather than from the checkpoint. The
+    /// critic still comes from the run.
+    pub init_actor: Option<PathBuf>,
     /// Keep the policy of every this many epochs under `snapshots/` (0: none).
     pub snapshot_every: usize,
     /// The run's first epochs in which only the critic learns ([`Learners::CriticOnly`]):
@@ -199,7 +204,7 @@ pub fn train<E: GoalEnv>(
         }
     }
     if let (true, Some(dir)) = (metrics.is_empty(), &options.init_from) {
-        warm_start(&mut agent, dir)?;
+        warm_start(&mut agent, dir, options.init_actor.as_deref())?;
     }
     let cycles = config.cycles_per_epoch as u64;
     let updates_per_epoch = (config.cycles_per_epoch * config.batches_per_cycle) as f64;
@@ -445,7 +450,7 @@ fn resume(
     if !checkpoint_dir.join("state.json").exists() {
         return Ok((Vec::new(), None));
     }
-    load_checkpoint(agent, &checkpoint_dir, |state, agent| {
+    load_checkpoint(agent, &checkpoint_dir, None, |state, agent| {
         let at = checkpoint_dir.display();
         let refusal = if state.dims != agent.dims || state.config != agent.config {
             format!(
@@ -472,7 +477,7 @@ fn resume(
 /// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had
 /// a shorter goal, as when a success test gains a part (LayerOpEnv's good state): the new goal
 /// inputs then start with zero weights, see [`widen_goal`].
-fn warm_start(agent: &mut Agent, dir: &Path) -> Result<(), TrainError> {
+fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Result<(), TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
         return Err(TrainError::WarmStart(format!(
@@ -480,7 +485,7 @@ fn warm_start(agent: &mut Agent, dir: &Path) -> Result<(), TrainError> {
             dir.display()
         )));
     }
-    load_checkpoint(agent, &checkpoint_dir, |state, agent| {
+    load_checkpoint(agent, &checkpoint_dir, actor_from, |state, agent| {
         let (saved, needed) = (state.dims, agent.dims);
         let fits = saved.observation == needed.observation
             && saved.action == needed.action
@@ -523,10 +528,12 @@ fn widen_goal(
 }
 
 /// Loads a checkpoint's networks and normalisers into `agent` once `check` has vetted its
-/// saved state; returns the epochs it records and the run it was warm-started from.
+/// saved state, the actor and normalisers from the policy at `actor_from` if given; returns
+/// the epochs it records and the run it was warm-started from.
 fn load_checkpoint(
     agent: &mut Agent,
     checkpoint_dir: &Path,
+    actor_from: Option<&Path>,
     check: impl Fn(&TrainState, &Agent) -> Result<(), TrainError>,
 ) -> Result<(Vec<EpochMetrics>, Option<PathBuf>), TrainError> {
     let mut state: TrainState = checkpoint::load_json(&checkpoint_dir.join("state.json"))?;
@@ -541,6 +548,21 @@ fn load_checkpoint(
             message,
         })
     };
+    if let Some(prefix) = actor_from {
+        let (weights, card_path) = crate::policy::policy_paths(prefix);
+        let card: crate::policy::PolicyCard = checkpoint::load_json(&card_path)?;
+        if card.dims != state.dims {
+            return Err(mismatch(format!(
+                "the policy {} has sizes {:?}, the run's networks {:?}: pass a policy of that run",
+                prefix.display(),
+                card.dims,
+                state.dims
+            )));
+        }
+        let actor = checkpoint::load_tensors(&weights)?;
+        (networks[0], networks[2]) = (actor.clone(), actor);
+        (state.observation_norm, state.goal_norm) = (card.observation_norm, card.goal_norm);
+    }
     let extra = agent.dims.goal.saturating_sub(state.dims.goal);
     if extra > 0 {
         widen_goal(&mut networks, &mut state.goal_norm, state.dims, extra).map_err(mismatch)?;

@@ -26,6 +26,7 @@ fn options(dir: &std::path::Path, epochs: usize, resume: bool) -> TrainOptions {
         out_dir: Some(dir.to_path_buf()),
         resume,
         init_from: None,
+        init_actor: None,
         snapshot_every: 2,
         critic_only_epochs: 0,
         progress: false,
@@ -173,6 +174,43 @@ fn a_warm_start_carries_the_networks_into_a_new_run() {
         .err()
         .unwrap();
     assert!(err.to_string().contains("holds no checkpoint"), "{err}");
+}
+
+/// A warm start can take its actor from a policy of the run, an earlier snapshot than the
+/// run's last checkpoint (as a shipped policy may be), and hold it while only the critic
+/// learns.
+#[test]
+fn a_warm_start_takes_the_actor_of_a_named_policy_and_can_hold_it() {
+    let source = fresh_dir("dexcube-rl-warm-actor-source");
+    train(PointMassEnv::default, config(), &options(&source, 3, false)).unwrap();
+    let tensors = |path: std::path::PathBuf| {
+        let mut tensors = dexcube_rl::checkpoint::load_tensors(&path).unwrap();
+        tensors.sort_by(|a, b| a.name.cmp(&b.name));
+        tensors
+    };
+    let snapshot = source.join("snapshots/epoch-0001");
+    let (earlier, last) = (
+        tensors(snapshot.with_extension("safetensors")),
+        tensors(source.join("checkpoint/actor.safetensors")),
+    );
+    assert!(dexcube_rl::params::l1_distance(&earlier, &last) > 0.0);
+    let dir = fresh_dir("dexcube-rl-warm-actor");
+    let held = TrainOptions {
+        init_from: Some(source.clone()),
+        init_actor: Some(snapshot),
+        critic_only_epochs: 1,
+        ..options(&dir, 1, false)
+    };
+    let run = train(PointMassEnv::default, config(), &held).unwrap();
+    let [mut actor, mut critic, ..] = run.agent.networks();
+    actor.sort_by(|a, b| a.name.cmp(&b.name));
+    critic.sort_by(|a, b| a.name.cmp(&b.name));
+    assert_eq!(actor, earlier, "the named policy's actor, held through the epoch");
+    let source_critic = tensors(source.join("checkpoint/critic.safetensors"));
+    assert!(
+        dexcube_rl::params::l1_distance(&critic, &source_critic) > 0.0,
+        "while the critic learnt"
+    );
 }
 
 /// The point mass with a third goal component appended (0 desired, the distance from the

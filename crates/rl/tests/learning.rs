@@ -26,6 +26,7 @@ fn options(epochs: usize) -> TrainOptions {
         out_dir: None,
         resume: false,
         init_from: None,
+        init_actor: None,
         snapshot_every: 0,
         critic_only_epochs: 0,
         progress: false,
