@@ -502,13 +502,9 @@ fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Resul
     .map(drop)
 }
 
-/// Rows the old inputs' statistics count as after [`widen_goal`]: about one cycle's worth,
-/// so the new inputs' statistics are the fresh rows' within a few cycles.
-const WIDENED_NORMALISER_ROWS: f64 = 1000.0;
-
 /// Gives networks saved for goals of `saved` components the `extra` goal components appended
 /// after them: zero weights in each first layer, so every network computes what it did, and
-/// goal statistics that learn the new components from fresh rows.
+/// goal statistics that keep the old components and feed the new ones as they are.
 fn widen_goal(
     networks: &mut [Vec<crate::params::NamedTensor>; 4],
     goal_norm: &mut crate::normalizer::Normalizer,
@@ -523,7 +519,7 @@ fn widen_goal(
             ));
         }
     }
-    *goal_norm = goal_norm.widened(extra, WIDENED_NORMALISER_ROWS);
+    *goal_norm = goal_norm.widened(extra);
     Ok(())
 }
 

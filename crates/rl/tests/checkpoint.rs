@@ -205,7 +205,10 @@ fn a_warm_start_takes_the_actor_of_a_named_policy_and_can_hold_it() {
     let [mut actor, mut critic, ..] = run.agent.networks();
     actor.sort_by(|a, b| a.name.cmp(&b.name));
     critic.sort_by(|a, b| a.name.cmp(&b.name));
-    assert_eq!(actor, earlier, "the named policy's actor, held through the epoch");
+    assert_eq!(
+        actor, earlier,
+        "the named policy's actor, held through the epoch"
+    );
     let source_critic = tensors(source.join("checkpoint/critic.safetensors"));
     assert!(
         dexcube_rl::params::l1_distance(&critic, &source_critic) > 0.0,
