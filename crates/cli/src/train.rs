@@ -106,6 +106,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         bail!("--quarter-goals is for LayerOpEnv (train layer)");
     }
     let object = args.choice.object()?;
+    let square = args.choice.square()?;
     let suffix = args
         .choice
         .named_object()?
@@ -118,7 +119,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 + if args.quarter_goals { "-quarter" } else { "" }
                 + &suffix
         }
-    } + if args.choice.square()? { "-square" } else { "" };
+    } + if square { "-square" } else { "" };
     let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
@@ -161,12 +162,14 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "env": name,
             "variant": variant,
             "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
-            "success": match (args.choice.env, args.choice.square()?) {
-                (EnvKind::Rot, false) => "pose",
-                (EnvKind::Rot, true) => "pose, cube left square",
-                (EnvKind::Layer, false) => "angle",
-                (EnvKind::Layer, true) => "angle, cube left square",
-            },
+            "success": format!(
+                "{}{}",
+                match args.choice.env {
+                    EnvKind::Rot => "pose",
+                    EnvKind::Layer => "angle",
+                },
+                if square { ", cube left square" } else { "" }
+            ),
             "object": object.name(),
             "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
             "critic_only_epochs": args.critic_only_epochs,

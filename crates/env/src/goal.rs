@@ -113,7 +113,7 @@ fn with_misalignment(goal: &[f64], square_threshold: Option<f64>, misalignment: 
 
 /// Whether an achieved goal leaves the cube square: its last part, the misalignment, within
 /// `square_threshold`. Always, for a test without one.
-fn left_square(square_threshold: Option<f64>, achieved: &[f64]) -> bool {
+fn leaves_square(square_threshold: Option<f64>, achieved: &[f64]) -> bool {
     square_threshold.is_none_or(|threshold| achieved.last().is_some_and(|&m| m < threshold))
 }
 
@@ -154,7 +154,7 @@ impl Goal for RotGoal {
         let (position, angle) = self.errors(achieved, desired);
         position < self.position_threshold
             && angle < self.angle_threshold
-            && left_square(self.square_threshold, achieved)
+            && leaves_square(self.square_threshold, achieved)
     }
 }
 
@@ -223,7 +223,7 @@ impl Goal for LayerGoal {
 
     fn is_success(&self, achieved: &[f64], desired: &[f64]) -> bool {
         self.errors(achieved, desired).1 < self.angle_threshold
-            && left_square(self.square_threshold, achieved)
+            && leaves_square(self.square_threshold, achieved)
     }
 }
 

@@ -257,12 +257,6 @@ pub fn is_square(sim: &Sim) -> bool {
     CubeState::read(sim).is_none_or(|cube| cube.is_aligned())
 }
 
-/// How far the object is from square, radians: a physical cube's largest cubelet offset from
-/// a quarter-turn position; 0 for any other object.
-pub fn misalignment(sim: &Sim) -> f64 {
-    CubeState::read(sim).map_or(0.0, |cube| cube.misalignment())
-}
-
 /// Lets the object settle with a neutral action; false if the physics blew up.
 fn settle(sim: &mut Sim) -> bool {
     sim.set_action(&[0.0; HAND_ACTUATORS]);

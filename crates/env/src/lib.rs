@@ -32,10 +32,10 @@ pub use dexcube_sim::SimError;
 pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{
     BASE_OBSERVATION, DROP_DEPTH, ObjectKind, SETTLE_STEPS, base_observation, is_dropped,
-    is_square, misalignment, resting_point, set_down,
+    is_square, resting_point, set_down,
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
-pub use rot::{CubeRotEnv, pose_goal};
+pub use rot::{CubeRotEnv, achieved_goal, pose_goal};
 pub use vec_env::VecEnv;
 
 /// Control steps in an episode (the paper's 100).

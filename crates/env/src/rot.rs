@@ -20,12 +20,13 @@
 
 use std::sync::Arc;
 
+use dexcube_sim::cube::CubeState;
 use dexcube_sim::rotation::Quat;
-use dexcube_sim::{Scene, SceneKind, SimError};
+use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, RotGoal, RotMode};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical, misalignment};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
 use crate::random::uniform_rotation;
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
@@ -105,15 +106,22 @@ impl CubeRotEnv {
 /// and with a goal that needs the good state, the cube's misalignment after it.
 fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64]) -> Observation {
     let observation = hand.base_observation();
-    let misalignment = match goal.square_threshold {
-        Some(_) => misalignment(&hand.sim),
-        None => 0.0,
-    };
     Observation {
-        achieved_goal: goal.achieved(&observation[48..55], misalignment),
+        achieved_goal: achieved_goal(goal, &hand.sim, &observation[48..55]),
         desired_goal: goal.desired(desired),
         observation,
     }
+}
+
+/// CubeRotEnv's achieved goal for the cube in `sim` at `pose` (position, then quaternion with
+/// w ≥ 0): with a goal that needs the good state, the cube's misalignment after it, which is
+/// read only then (0 for the rigid cube, which is always square).
+pub fn achieved_goal(goal: &RotGoal, sim: &Sim, pose: &[f64]) -> Vec<f64> {
+    let misalignment = match goal.square_threshold {
+        Some(_) => CubeState::read(sim).map_or(0.0, |cube| cube.misalignment()),
+        None => 0.0,
+    };
+    goal.achieved(pose, misalignment)
 }
 
 /// A pose as CubeRotEnv's goal vector: position, then the quaternion with w ≥ 0.

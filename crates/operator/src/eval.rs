@@ -44,7 +44,6 @@ pub struct PolicyFiles {
 pub struct LoadedStages {
     pub stage1: PolicyStage1,
     pub stage2: PolicyStage2,
-    pub rot_mode: RotMode,
     pub resting: [f64; 3],
 }
 
@@ -68,7 +67,6 @@ impl PolicyFiles {
                 resting_z: resting[2],
                 driving: Driving::default(),
             },
-            rot_mode: self.rot_mode,
             resting,
         })
     }
@@ -169,7 +167,8 @@ pub fn run_cube(
     let mut sim = Sim::new(scene.clone());
     let resting = stages.resting;
     set_up_scramble(&mut sim, scramble, resting);
-    let accepts = pose_reached(RotGoal::paper(stages.rot_mode));
+    // The rollback's check is the paper's pose test in the policy's mode.
+    let accepts = pose_reached(RotGoal::paper(stages.stage1.goal.mode));
     stages.stage1.driving = config.driving;
     stages.stage2.driving = config.driving;
     let mut operator = Operator {

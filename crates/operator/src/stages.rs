@@ -9,8 +9,8 @@ use std::path::Path;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS, base_observation,
-    is_dropped, misalignment, pose_goal, set_down,
+    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS, achieved_goal,
+    base_observation, is_dropped, pose_goal, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -340,12 +340,8 @@ pub fn randomise_pose(sim: &mut Sim, position: [f64; 3], rng: &mut ChaCha8Rng) {
 pub fn pose_reached(goal: RotGoal) -> impl Fn(&Sim, [f64; 3], Quat) -> bool {
     move |sim, position, target| {
         let pose = sim.object_pose();
-        let off_square = match goal.square_threshold {
-            Some(_) => misalignment(sim),
-            None => 0.0,
-        };
         goal.is_success(
-            &goal.achieved(&pose_goal(pose.position, pose.orientation), off_square),
+            &achieved_goal(&goal, sim, &pose_goal(pose.position, pose.orientation)),
             &goal.desired(&pose_goal(position, target)),
         )
     }
