@@ -48,10 +48,11 @@ pub struct TrainArgs {
     /// to fine-tune on another success test or goal range); a new run in --out.
     #[arg(long, value_name = "DIR", conflicts_with = "resume")]
     init: Option<PathBuf>,
-    /// With --init: take the actor and its normalisers from this policy (PREFIX.safetensors
-    /// and PREFIX.json, e.g. models/rot, which may be an earlier epoch than the run's last
-    /// checkpoint); the critic still comes from the --init run.
-    #[arg(long, value_name = "PREFIX", requires = "init")]
+    /// Warm start the actor and its normalisers from this policy (PREFIX.safetensors and
+    /// PREFIX.json, e.g. models/rot, which may be an earlier epoch than a run's last
+    /// checkpoint). The critic comes from the --init run, or without one starts afresh: then
+    /// give it --critic-only-epochs to learn the policy's values first.
+    #[arg(long, value_name = "PREFIX", conflicts_with = "resume")]
     init_actor: Option<PathBuf>,
     /// LayerOpEnv only: train on the evaluation goal, exactly a quarter turn, rather than
     /// goals uniform over it (HER still relabels with the angles reached on the way).
@@ -74,6 +75,13 @@ pub struct TrainArgs {
     /// Fine-tuning a policy that already succeeds may want less of both.
     #[arg(long, value_name = "P")]
     random_eps: Option<f64>,
+    /// Adam learning rate of the actor (HER baselines: 0.001).
+    #[arg(long, value_name = "RATE")]
+    actor_lr: Option<f64>,
+    /// Fine-tuning: weight of a penalty on the actor's squared distance from the actor it
+    /// starts from (--init or --init-actor), beside the action penalty (DDPG: 0).
+    #[arg(long, default_value_t = 0.0, value_name = "WEIGHT")]
+    anchor: f64,
     /// Train without Hindsight Experience Replay (plain DDPG), for ablations.
     #[arg(long)]
     no_her: bool,
@@ -135,8 +143,22 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         her: !args.no_her,
         noise_eps: args.noise_eps.unwrap_or(published.noise_eps),
         random_eps: args.random_eps.unwrap_or(published.random_eps),
+        actor_lr: args.actor_lr.unwrap_or(published.actor_lr),
+        anchor: args.anchor,
         ..published
     };
+    if !(config.actor_lr > 0.0 && config.actor_lr.is_finite()) {
+        bail!(
+            "--actor-lr must be a positive number, not {}",
+            config.actor_lr
+        );
+    }
+    if !(config.anchor >= 0.0 && config.anchor.is_finite()) {
+        bail!("--anchor must be 0 or more, not {}", config.anchor);
+    }
+    if config.anchor > 0.0 && args.init.is_none() && args.init_actor.is_none() && !resume {
+        bail!("--anchor holds the actor near the one it starts from: pass --init or --init-actor");
+    }
     for (name, value) in [
         ("--noise-eps", config.noise_eps),
         ("--random-eps", config.random_eps),

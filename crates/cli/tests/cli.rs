@@ -325,6 +325,19 @@ fn train_refuses_settings_it_cannot_run() {
             &["layer", "--noise-eps=-0.1"],
             "--noise-eps must be between 0 and 1",
         ),
+        (&["rot", "--actor-lr", "0"], "--actor-lr must be a positive"),
+        (&["rot", "--anchor=-1"], "--anchor must be 0 or more"),
+        (&["rot", "--anchor", "10"], "pass --init or --init-actor"),
+        (
+            &[
+                "rot",
+                "--object",
+                "cube",
+                "--init-actor",
+                concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/layer"),
+            ],
+            "cannot warm-start: the policy",
+        ),
     ] {
         let o = dexcube(
             &[&["train"][..], args, &["--out", "/nonexistent/run"]].concat(),

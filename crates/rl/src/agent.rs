@@ -8,7 +8,10 @@
 //!   y = -1/(1-γ), whatever the goal. Bootstrapping from a state that no stored transition
 //!   starts from would make a drop look as good as the critic's guess about it;
 //! - critic   minimise mean (Q(o, g, u) - y)²;
-//! - actor    minimise -mean Q(o, g, π(o, g)) + action_l2 · mean π(o, g)²;
+//! - actor    minimise -mean Q(o, g, π(o, g)) + action_l2 · mean π(o, g)²,
+//!   and, when fine-tuning with an anchor, + anchor · mean (π(o, g) - π₀(o, g))², where π₀
+//!   is the actor as it was loaded, with the normalisers it was loaded with (fixed, so it
+//!   acts as it did however the run's statistics move; `DdpgHerConfig::anchor`, 0 in DDPG);
 //!
 //! both gradients taken from the same forward pass, as baselines does. Target networks live
 //! on the plain (non-autodiff) device, so their updates can never grow an autodiff graph.
@@ -57,6 +60,21 @@ pub enum Learners {
     CriticOnly,
 }
 
+/// The actor a fine-tuning run is held near, as saved: its weights and the normalisers it
+/// was loaded with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SavedAnchor {
+    pub actor: Vec<params::NamedTensor>,
+    pub observation_norm: Normalizer,
+    pub goal_norm: Normalizer,
+}
+
+/// A [`SavedAnchor`] with its network built (plain device), for the actor's loss.
+struct Anchor {
+    actor: Mlp,
+    saved: SavedAnchor,
+}
+
 /// What one optimisation step measured.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StepStats {
@@ -76,6 +94,8 @@ pub struct Agent {
     target_critic: Mlp,
     /// A no-autodiff copy of the actor for acting, refreshed after each cycle.
     policy: Mlp,
+    /// The actor the anchor penalty holds this one near, once set.
+    anchor: Option<Anchor>,
     actor_optimizer: ModuleOptimizer,
     critic_optimizer: ModuleOptimizer,
     pub observation_norm: Normalizer,
@@ -98,6 +118,7 @@ impl Agent {
             target_actor: actor.valid(),
             target_critic: critic.valid(),
             policy: actor.valid(),
+            anchor: None,
             actor,
             critic,
             actor_optimizer: AdamConfig::new().init(),
@@ -201,7 +222,21 @@ impl Agent {
         let critic_loss = (q.clone() - target).powi_scalar(2).mean();
         let pi = self.actor.forward(x.clone()).tanh();
         let q_pi = self.critic.forward(Tensor::cat(vec![x, pi.clone()], 1));
-        let actor_loss = q_pi.mean().neg() + pi.powi_scalar(2).mean() * self.config.action_l2;
+        let mut actor_loss =
+            q_pi.mean().neg() + pi.clone().powi_scalar(2).mean() * self.config.action_l2;
+        if let Some(anchor) = self.anchor.as_ref().filter(|_| self.config.anchor > 0.0) {
+            let x = network_inputs(
+                &anchor.saved.observation_norm,
+                &anchor.saved.goal_norm,
+                &batch.observation,
+                &batch.goal,
+                n,
+                &self.plain,
+            );
+            let held: Tensor<2> =
+                Tensor::from_data(anchor.actor.forward(x).tanh().into_data(), &self.device);
+            actor_loss = actor_loss + (pi - held).powi_scalar(2).mean() * self.config.anchor;
+        }
 
         let stats = StepStats {
             critic_loss: scalar(&critic_loss),
@@ -253,6 +288,32 @@ impl Agent {
         self.target_actor.visit(&mut any);
         self.target_critic.visit(&mut any);
         !any.0
+    }
+
+    /// Makes the actor as it is now, with the normalisers as they are now, the anchor that
+    /// `DdpgHerConfig::anchor` holds it near.
+    pub fn set_anchor_here(&mut self) {
+        self.anchor = Some(Anchor {
+            actor: self.actor.valid(),
+            saved: SavedAnchor {
+                actor: self.actor_params(),
+                observation_norm: self.observation_norm.clone(),
+                goal_norm: self.goal_norm.clone(),
+            },
+        });
+    }
+
+    /// The anchor, if one is set, for checkpoints.
+    pub fn anchor(&self) -> Option<&SavedAnchor> {
+        self.anchor.as_ref().map(|anchor| &anchor.saved)
+    }
+
+    /// Sets the anchor to one saved from `anchor`.
+    pub fn load_anchor(&mut self, saved: SavedAnchor) -> Result<(), params::ParamMismatch> {
+        let replace = |_: &[f32], given: &[f32]| given.to_vec();
+        let actor = params::write(self.actor.valid(), &saved.actor, replace)?;
+        self.anchor = Some(Anchor { actor, saved });
+        Ok(())
     }
 
     /// The actor's parameters: what a shipped policy holds.

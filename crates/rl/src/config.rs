@@ -43,6 +43,12 @@ pub struct DdpgHerConfig {
     pub batches_per_cycle: usize,
     /// Deterministic test episodes per epoch (`n_test_rollouts`).
     pub test_episodes: usize,
+    /// Weight of a penalty on the actor's squared distance from the actor it was warm-started
+    /// with (the anchor), in its loss beside `action_l2`. Not in DDPG or the baselines (0):
+    /// behaviour regularisation towards a reference policy, as TD3+BC (Fujimoto and Gu,
+    /// NeurIPS 2021) regularises towards the data, for fine-tuning a policy that already
+    /// works on a new object without its first updates undoing it.
+    pub anchor: f64,
 }
 
 impl Default for DdpgHerConfig {
@@ -66,6 +72,7 @@ impl Default for DdpgHerConfig {
             cycles_per_epoch: 50,
             batches_per_cycle: 40,
             test_episodes: 10,
+            anchor: 0.0,
         }
     }
 }

@@ -28,7 +28,7 @@ pub mod replay;
 pub mod rollout;
 pub mod train;
 
-pub use agent::{Agent, Dims, Learners};
+pub use agent::{Agent, Dims, Learners, SavedAnchor};
 pub use config::DdpgHerConfig;
 pub use policy::Policy;
 pub use train::{EpochMetrics, TrainOptions, train};

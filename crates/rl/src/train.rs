@@ -28,7 +28,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::agent::{Agent, Dims, Learners, StepStats};
+use crate::agent::{Agent, Dims, Learners, SavedAnchor, StepStats};
 use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
 use crate::normalizer::Normalizer;
@@ -51,10 +51,11 @@ pub struct TrainOptions {
     /// Warm start: take the networks and normalisers of the run in this folder (its
     /// `checkpoint/`), then train as a new run. Only the sizes must match.
     pub init_from: Option<PathBuf>,
-    /// With `init_from`: take the actor (and its target) and the normalisers from this
-    /// policy (`PREFIX.safetensors` and `PREFIX.json`, e.g. a shipped one, which may be an
-    /// earlier epoch than the run's last checkpoint) rather than from the checkpoint. The
-    /// critic still comes from the run.
+    /// Take the actor (and its target) and the normalisers from this policy
+    /// (`PREFIX.safetensors` and `PREFIX.json`, e.g. a shipped one, which may be an earlier
+    /// epoch than a run's last checkpoint). With `init_from` the critic comes from that run;
+    /// without, it starts afresh, and `critic_only_epochs` should give it time to learn the
+    /// policy's values first.
     pub init_actor: Option<PathBuf>,
     /// Keep the policy of every this many epochs under `snapshots/` (0: none).
     pub snapshot_every: usize,
@@ -131,6 +132,10 @@ struct TrainState {
     /// The run this one was warm-started from, kept so a resumed run's cards still say so.
     #[serde(default)]
     init_from: Option<PathBuf>,
+    /// The anchor's normalisers (observation, goal), for a run fine-tuned with one; its
+    /// weights are `checkpoint/anchor.safetensors`.
+    #[serde(default)]
+    anchor_normalizers: Option<[Normalizer; 2]>,
 }
 
 #[derive(Debug)]
@@ -168,6 +173,9 @@ pub struct Trained {
 
 const NETWORK_FILES: [&str; 4] = ["actor", "critic", "target_actor", "target_critic"];
 
+/// The anchor's weights in a checkpoint, for a run fine-tuned with one.
+const ANCHOR_FILE: &str = "anchor.safetensors";
+
 /// A seed for the `batch`-th batch of episodes, distinct for training and testing.
 fn episode_seed(seed: u64, batch: u64, test: bool) -> u64 {
     seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (batch << 20) ^ ((test as u64) << 62)
@@ -203,8 +211,22 @@ pub fn train<E: GoalEnv>(
             init_from = resumed_from;
         }
     }
-    if let (true, Some(dir)) = (metrics.is_empty(), &options.init_from) {
-        warm_start(&mut agent, dir, options.init_actor.as_deref())?;
+    if metrics.is_empty() {
+        match (&options.init_from, &options.init_actor) {
+            (Some(dir), actor_from) => warm_start(&mut agent, dir, actor_from.as_deref())?,
+            (None, Some(prefix)) => warm_start_actor(&mut agent, prefix)?,
+            (None, None) if config.anchor > 0.0 => {
+                return Err(TrainError::WarmStart(
+                    "an anchor holds the actor near the one it starts from, so it needs a \
+                     warm start (a run or a policy to start from)"
+                        .into(),
+                ));
+            }
+            (None, None) => {}
+        }
+        if config.anchor > 0.0 {
+            agent.set_anchor_here();
+        }
     }
     let cycles = config.cycles_per_epoch as u64;
     let updates_per_epoch = (config.cycles_per_epoch * config.batches_per_cycle) as f64;
@@ -376,6 +398,9 @@ fn save_epoch(
             &tensors,
         )?;
     }
+    if let Some(anchor) = agent.anchor() {
+        checkpoint::save_tensors(&checkpoint_dir.join(ANCHOR_FILE), &anchor.actor)?;
+    }
     let state = TrainState {
         label: options.label.clone(),
         seed: options.seed,
@@ -385,6 +410,9 @@ fn save_epoch(
         goal_norm: agent.goal_norm.clone(),
         metrics: metrics.to_vec(),
         init_from: init_from.map(Path::to_path_buf),
+        anchor_normalizers: agent
+            .anchor()
+            .map(|anchor| [anchor.observation_norm.clone(), anchor.goal_norm.clone()]),
     };
     // The state goes last: a checkpoint is complete once state.json names its epoch.
     checkpoint::save_json(&checkpoint_dir.join("state.json"), &state)?;
@@ -450,7 +478,7 @@ fn resume(
     if !checkpoint_dir.join("state.json").exists() {
         return Ok((Vec::new(), None));
     }
-    load_checkpoint(agent, &checkpoint_dir, None, |state, agent| {
+    let resumed = load_checkpoint(agent, &checkpoint_dir, None, |state, agent| {
         let at = checkpoint_dir.display();
         let refusal = if state.dims != agent.dims || state.config != agent.config {
             format!(
@@ -471,7 +499,28 @@ fn resume(
             return Ok(());
         };
         Err(TrainError::Resume(refusal))
-    })
+    })?;
+    if agent.config.anchor > 0.0 {
+        let path = checkpoint_dir.join(ANCHOR_FILE);
+        let mismatch = |message: String| {
+            TrainError::Checkpoint(CheckpointError::Mismatch {
+                path: path.clone(),
+                message,
+            })
+        };
+        let [observation_norm, goal_norm] = resumed
+            .anchor_normalizers
+            .ok_or_else(|| mismatch("state.json keeps no normalisers for the anchor".into()))?;
+        let saved = SavedAnchor {
+            actor: checkpoint::load_tensors(&path)?,
+            observation_norm,
+            goal_norm,
+        };
+        agent
+            .load_anchor(saved)
+            .map_err(|e| mismatch(e.to_string()))?;
+    }
+    Ok((resumed.metrics, resumed.init_from))
 }
 
 /// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had
@@ -487,10 +536,7 @@ fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Resul
     }
     load_checkpoint(agent, &checkpoint_dir, actor_from, |state, agent| {
         let (saved, needed) = (state.dims, agent.dims);
-        let fits = saved.observation == needed.observation
-            && saved.action == needed.action
-            && saved.goal <= needed.goal;
-        if fits {
+        if can_start_from(saved, needed) {
             Ok(())
         } else {
             Err(TrainError::WarmStart(format!(
@@ -502,17 +548,65 @@ fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Resul
     .map(drop)
 }
 
+/// Takes the actor (and its target) and the normalisers of the policy at `prefix` for a new
+/// run whose critic starts afresh. The policy may have had a shorter goal, as for
+/// [`warm_start`].
+fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> {
+    let (weights, card_path) = crate::policy::policy_paths(prefix);
+    let card: crate::policy::PolicyCard = checkpoint::load_json(&card_path)?;
+    let (saved, needed) = (card.dims, agent.dims);
+    if !can_start_from(saved, needed) {
+        return Err(TrainError::WarmStart(format!(
+            "the policy {} is for {saved:?}, this environment needs {needed:?}",
+            prefix.display()
+        )));
+    }
+    let mismatch = |message: String| {
+        TrainError::Checkpoint(CheckpointError::Mismatch {
+            path: weights.clone(),
+            message,
+        })
+    };
+    let mut actor = checkpoint::load_tensors(&weights)?;
+    let mut goal_norm = card.goal_norm;
+    if needed.goal > saved.goal {
+        widen_goal(
+            &mut [("actor", &mut actor)],
+            &mut goal_norm,
+            saved,
+            needed.goal - saved.goal,
+        )
+        .map_err(mismatch)?;
+    }
+    let mut networks = agent.networks();
+    (networks[0], networks[2]) = (actor.clone(), actor);
+    agent
+        .load_networks(&networks)
+        .map_err(|e| mismatch(e.to_string()))?;
+    agent.observation_norm = card.observation_norm;
+    agent.goal_norm = goal_norm;
+    Ok(())
+}
+
+/// Whether networks for `saved` sizes can start a run that needs `needed`: the same
+/// observation and action, and a goal no longer (new goal parts are appended).
+fn can_start_from(saved: Dims, needed: Dims) -> bool {
+    saved.observation == needed.observation
+        && saved.action == needed.action
+        && saved.goal <= needed.goal
+}
+
 /// Gives networks saved for goals of `saved` components the `extra` goal components appended
 /// after them: zero weights in each first layer, so every network computes what it did, and
 /// goal statistics that keep the old components and feed the new ones as they are.
 fn widen_goal(
-    networks: &mut [Vec<crate::params::NamedTensor>; 4],
+    networks: &mut [(&str, &mut Vec<crate::params::NamedTensor>)],
     goal_norm: &mut crate::normalizer::Normalizer,
     dims: Dims,
     extra: usize,
 ) -> Result<(), String> {
     let at = dims.observation + dims.goal;
-    for (tensors, name) in networks.iter_mut().zip(NETWORK_FILES) {
+    for (name, tensors) in networks.iter_mut() {
         if !crate::params::insert_zero_inputs(tensors, "layers.0.weight", at, extra) {
             return Err(format!(
                 "the {name} network has no first layer with {at} inputs or more"
@@ -525,13 +619,13 @@ fn widen_goal(
 
 /// Loads a checkpoint's networks and normalisers into `agent` once `check` has vetted its
 /// saved state, the actor and normalisers from the policy at `actor_from` if given; returns
-/// the epochs it records and the run it was warm-started from.
+/// the saved state.
 fn load_checkpoint(
     agent: &mut Agent,
     checkpoint_dir: &Path,
     actor_from: Option<&Path>,
     check: impl Fn(&TrainState, &Agent) -> Result<(), TrainError>,
-) -> Result<(Vec<EpochMetrics>, Option<PathBuf>), TrainError> {
+) -> Result<TrainState, TrainError> {
     let mut state: TrainState = checkpoint::load_json(&checkpoint_dir.join("state.json"))?;
     check(&state, agent)?;
     let mut networks: [Vec<crate::params::NamedTensor>; 4] = Default::default();
@@ -561,12 +655,13 @@ fn load_checkpoint(
     }
     let extra = agent.dims.goal.saturating_sub(state.dims.goal);
     if extra > 0 {
-        widen_goal(&mut networks, &mut state.goal_norm, state.dims, extra).map_err(mismatch)?;
+        let mut named: Vec<_> = NETWORK_FILES.into_iter().zip(networks.iter_mut()).collect();
+        widen_goal(&mut named, &mut state.goal_norm, state.dims, extra).map_err(mismatch)?;
     }
     agent
         .load_networks(&networks)
         .map_err(|e| mismatch(e.to_string()))?;
-    agent.observation_norm = state.observation_norm;
-    agent.goal_norm = state.goal_norm;
-    Ok((state.metrics, state.init_from))
+    agent.observation_norm = state.observation_norm.clone();
+    agent.goal_norm = state.goal_norm.clone();
+    Ok(state)
 }

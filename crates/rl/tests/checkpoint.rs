@@ -216,6 +216,114 @@ fn a_warm_start_takes_the_actor_of_a_named_policy_and_can_hold_it() {
     );
 }
 
+/// A policy alone can warm-start a run: its actor and normalisers carry over, the critic starts
+/// afresh. With an anchor the actor learns while held near that start, and a resumed run keeps
+/// the same anchor.
+#[test]
+fn a_policy_alone_warm_starts_the_actor_and_an_anchor_holds_it_near() {
+    let source = fresh_dir("dexcube-rl-anchor-source");
+    train(PointMassEnv::default, config(), &options(&source, 1, false)).unwrap();
+    let sorted = |mut tensors: Vec<dexcube_rl::params::NamedTensor>| {
+        tensors.sort_by(|a, b| a.name.cmp(&b.name));
+        tensors
+    };
+    let start =
+        sorted(dexcube_rl::checkpoint::load_tensors(&source.join("policy.safetensors")).unwrap());
+    let from_policy = |name: &str, anchor: f64| {
+        let dir = fresh_dir(name);
+        let options = TrainOptions {
+            init_actor: Some(source.join("policy")),
+            ..options(&dir, 3, false)
+        };
+        let config = DdpgHerConfig {
+            anchor,
+            actor_lr: 1e-2,
+            ..config()
+        };
+        (dir, options, config)
+    };
+    let (_, held, frozen) = from_policy("dexcube-rl-anchor-frozen", 0.0);
+    let frozen = DdpgHerConfig {
+        batches_per_cycle: 0,
+        ..frozen
+    };
+    let run = train(PointMassEnv::default, frozen, &held).unwrap();
+    assert_eq!(
+        sorted(run.agent.networks()[0].clone()),
+        start,
+        "the actor is the policy's"
+    );
+    // How far the trained actor's actions are from the start's, on 20 episodes' first states.
+    let device = burn::prelude::Device::flex();
+    let started = Policy::load(&source.join("policy"), &device).unwrap();
+    let moved = |anchor: f64| {
+        let (dir, options, config) = from_policy(&format!("dexcube-rl-anchor-{anchor}"), anchor);
+        let config = DdpgHerConfig {
+            batches_per_cycle: 20,
+            ..config
+        };
+        let run = train(PointMassEnv::default, config, &options).unwrap();
+        let mut env = PointMassEnv::default();
+        let distance: f64 = (0..20)
+            .map(|seed| {
+                let (obs, _) = env.reset(Some(seed));
+                let now = run
+                    .agent
+                    .act(&obs.observation, &obs.desired_goal, 1, None)
+                    .remove(0);
+                let then = started.act(&obs.observation, &obs.desired_goal);
+                now.iter()
+                    .zip(&then)
+                    .map(|(a, b)| (a - b).abs())
+                    .sum::<f64>()
+            })
+            .sum();
+        (dir, distance)
+    };
+    let (_, free) = moved(0.0);
+    let (dir, anchored) = moved(100.0);
+    assert!(anchored > 0.0, "the anchored actor still learns");
+    assert!(
+        anchored < 0.5 * free,
+        "the anchor holds the actor near its start: {anchored} against {free}"
+    );
+    let (_, mut resumed, config) = from_policy("dexcube-rl-anchor-unused", 100.0);
+    let config = DdpgHerConfig {
+        batches_per_cycle: 20,
+        ..config
+    };
+    resumed.resume = true;
+    resumed.out_dir = Some(dir.clone());
+    resumed.init_actor = None;
+    resumed.epochs = 4;
+    let run = train(PointMassEnv::default, config, &resumed).unwrap();
+    assert_eq!(run.metrics.len(), 4);
+    let anchor = run.agent.anchor().unwrap();
+    assert_eq!(
+        sorted(anchor.actor.clone()),
+        start,
+        "the resumed run holds the same anchor"
+    );
+    assert_eq!(
+        [&anchor.observation_norm, &anchor.goal_norm],
+        [&started.card.observation_norm, &started.card.goal_norm],
+        "with the normalisers it started from, while the run's own moved on"
+    );
+    assert_ne!(run.agent.observation_norm, anchor.observation_norm);
+    let nowhere = TrainOptions {
+        init_actor: None,
+        ..from_policy("dexcube-rl-anchor-nowhere", 1.0).1
+    };
+    let err = train(
+        PointMassEnv::default,
+        from_policy("dexcube-rl-anchor-unused", 1.0).2,
+        &nowhere,
+    )
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("needs a warm start"), "{err}");
+}
+
 /// The point mass with a third goal component appended (0 desired, the distance from the
 /// origin achieved) that its success test also reads, as LayerOpEnv's good state joins the
 /// layer angle.
