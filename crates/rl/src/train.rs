@@ -502,15 +502,12 @@ fn resume(
     })?;
     if agent.config.anchor > 0.0 {
         let path = checkpoint_dir.join(ANCHOR_FILE);
-        let mismatch = |message: String| {
-            TrainError::Checkpoint(CheckpointError::Mismatch {
-                path: path.clone(),
-                message,
-            })
-        };
-        let [observation_norm, goal_norm] = resumed
-            .anchor_normalizers
-            .ok_or_else(|| mismatch("state.json keeps no normalisers for the anchor".into()))?;
+        let [observation_norm, goal_norm] = resumed.anchor_normalizers.ok_or_else(|| {
+            mismatch(
+                &path,
+                "state.json keeps no normalisers for the anchor".into(),
+            )
+        })?;
         let saved = SavedAnchor {
             actor: checkpoint::load_tensors(&path)?,
             observation_norm,
@@ -518,7 +515,7 @@ fn resume(
         };
         agent
             .load_anchor(saved)
-            .map_err(|e| mismatch(e.to_string()))?;
+            .map_err(|e| mismatch(&path, e.to_string()))?;
     }
     Ok((resumed.metrics, resumed.init_from))
 }
@@ -552,8 +549,7 @@ fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Resul
 /// run whose critic starts afresh. The policy may have had a shorter goal, as for
 /// [`warm_start`].
 fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> {
-    let (weights, card_path) = crate::policy::policy_paths(prefix);
-    let card: crate::policy::PolicyCard = checkpoint::load_json(&card_path)?;
+    let (mut actor, card) = read_policy(prefix)?;
     let (saved, needed) = (card.dims, agent.dims);
     if !can_start_from(saved, needed) {
         return Err(TrainError::WarmStart(format!(
@@ -561,13 +557,6 @@ fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> 
             prefix.display()
         )));
     }
-    let mismatch = |message: String| {
-        TrainError::Checkpoint(CheckpointError::Mismatch {
-            path: weights.clone(),
-            message,
-        })
-    };
-    let mut actor = checkpoint::load_tensors(&weights)?;
     let mut goal_norm = card.goal_norm;
     if needed.goal > saved.goal {
         widen_goal(
@@ -576,16 +565,33 @@ fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> 
             saved,
             needed.goal - saved.goal,
         )
-        .map_err(mismatch)?;
+        .map_err(|message| mismatch(prefix, message))?;
     }
     let mut networks = agent.networks();
     (networks[0], networks[2]) = (actor.clone(), actor);
     agent
         .load_networks(&networks)
-        .map_err(|e| mismatch(e.to_string()))?;
+        .map_err(|e| mismatch(prefix, e.to_string()))?;
     agent.observation_norm = card.observation_norm;
     agent.goal_norm = goal_norm;
     Ok(())
+}
+
+/// The actor's weights and the card of the policy at `prefix`.
+fn read_policy(
+    prefix: &Path,
+) -> Result<(Vec<crate::params::NamedTensor>, crate::policy::PolicyCard), TrainError> {
+    let (weights, card_path) = crate::policy::policy_paths(prefix);
+    let card = checkpoint::load_json(&card_path)?;
+    Ok((checkpoint::load_tensors(&weights)?, card))
+}
+
+/// The error for saved networks at `path` that do not fit, saying why.
+fn mismatch(path: &Path, message: String) -> TrainError {
+    TrainError::Checkpoint(CheckpointError::Mismatch {
+        path: path.to_path_buf(),
+        message,
+    })
 }
 
 /// Whether networks for `saved` sizes can start a run that needs `needed`: the same
@@ -632,35 +638,31 @@ fn load_checkpoint(
     for (slot, name) in networks.iter_mut().zip(NETWORK_FILES) {
         *slot = checkpoint::load_tensors(&checkpoint_dir.join(format!("{name}.safetensors")))?;
     }
-    let mismatch = |message: String| {
-        TrainError::Checkpoint(CheckpointError::Mismatch {
-            path: checkpoint_dir.to_path_buf(),
-            message,
-        })
-    };
     if let Some(prefix) = actor_from {
-        let (weights, card_path) = crate::policy::policy_paths(prefix);
-        let card: crate::policy::PolicyCard = checkpoint::load_json(&card_path)?;
+        let (actor, card) = read_policy(prefix)?;
         if card.dims != state.dims {
-            return Err(mismatch(format!(
-                "the policy {} has sizes {:?}, the run's networks {:?}: pass a policy of that run",
-                prefix.display(),
-                card.dims,
-                state.dims
-            )));
+            return Err(mismatch(
+                checkpoint_dir,
+                format!(
+                    "the policy {} has sizes {:?}, the run's networks {:?}: pass a policy of that run",
+                    prefix.display(),
+                    card.dims,
+                    state.dims
+                ),
+            ));
         }
-        let actor = checkpoint::load_tensors(&weights)?;
         (networks[0], networks[2]) = (actor.clone(), actor);
         (state.observation_norm, state.goal_norm) = (card.observation_norm, card.goal_norm);
     }
     let extra = agent.dims.goal.saturating_sub(state.dims.goal);
     if extra > 0 {
         let mut named: Vec<_> = NETWORK_FILES.into_iter().zip(networks.iter_mut()).collect();
-        widen_goal(&mut named, &mut state.goal_norm, state.dims, extra).map_err(mismatch)?;
+        widen_goal(&mut named, &mut state.goal_norm, state.dims, extra)
+            .map_err(|message| mismatch(checkpoint_dir, message))?;
     }
     agent
         .load_networks(&networks)
-        .map_err(|e| mismatch(e.to_string()))?;
+        .map_err(|e| mismatch(checkpoint_dir, e.to_string()))?;
     agent.observation_norm = state.observation_norm.clone();
     agent.goal_norm = state.goal_norm.clone();
     Ok(state)
