@@ -69,10 +69,12 @@ pub struct SavedAnchor {
     pub goal_norm: Normalizer,
 }
 
-/// A [`SavedAnchor`] with its network built (plain device), for the actor's loss.
+/// The anchor as the actor's loss uses it: its network built (plain device), and the
+/// normalisers it reads its inputs through.
 struct Anchor {
     actor: Mlp,
-    saved: SavedAnchor,
+    observation_norm: Normalizer,
+    goal_norm: Normalizer,
 }
 
 /// What one optimisation step measured.
@@ -226,8 +228,8 @@ impl Agent {
             q_pi.mean().neg() + pi.clone().powi_scalar(2).mean() * self.config.action_l2;
         if let Some(anchor) = self.anchor.as_ref().filter(|_| self.config.anchor > 0.0) {
             let x = network_inputs(
-                &anchor.saved.observation_norm,
-                &anchor.saved.goal_norm,
+                &anchor.observation_norm,
+                &anchor.goal_norm,
                 &batch.observation,
                 &batch.goal,
                 n,
@@ -295,24 +297,28 @@ impl Agent {
     pub fn set_anchor_here(&mut self) {
         self.anchor = Some(Anchor {
             actor: self.actor.valid(),
-            saved: SavedAnchor {
-                actor: self.actor_params(),
-                observation_norm: self.observation_norm.clone(),
-                goal_norm: self.goal_norm.clone(),
-            },
+            observation_norm: self.observation_norm.clone(),
+            goal_norm: self.goal_norm.clone(),
         });
     }
 
-    /// The anchor, if one is set, for checkpoints.
-    pub fn anchor(&self) -> Option<&SavedAnchor> {
-        self.anchor.as_ref().map(|anchor| &anchor.saved)
+    /// The anchor, if one is set, as a checkpoint saves it.
+    pub fn anchor(&self) -> Option<SavedAnchor> {
+        self.anchor.as_ref().map(|anchor| SavedAnchor {
+            actor: params::read(&anchor.actor),
+            observation_norm: anchor.observation_norm.clone(),
+            goal_norm: anchor.goal_norm.clone(),
+        })
     }
 
     /// Sets the anchor to one saved from `anchor`.
     pub fn load_anchor(&mut self, saved: SavedAnchor) -> Result<(), params::ParamMismatch> {
         let replace = |_: &[f32], given: &[f32]| given.to_vec();
-        let actor = params::write(self.actor.valid(), &saved.actor, replace)?;
-        self.anchor = Some(Anchor { actor, saved });
+        self.anchor = Some(Anchor {
+            actor: params::write(self.actor.valid(), &saved.actor, replace)?,
+            observation_norm: saved.observation_norm,
+            goal_norm: saved.goal_norm,
+        });
         Ok(())
     }
 

@@ -398,7 +398,8 @@ fn save_epoch(
             &tensors,
         )?;
     }
-    if let Some(anchor) = agent.anchor() {
+    let anchor = agent.anchor();
+    if let Some(anchor) = &anchor {
         checkpoint::save_tensors(&checkpoint_dir.join(ANCHOR_FILE), &anchor.actor)?;
     }
     let state = TrainState {
@@ -410,9 +411,7 @@ fn save_epoch(
         goal_norm: agent.goal_norm.clone(),
         metrics: metrics.to_vec(),
         init_from: init_from.map(Path::to_path_buf),
-        anchor_normalizers: agent
-            .anchor()
-            .map(|anchor| [anchor.observation_norm.clone(), anchor.goal_norm.clone()]),
+        anchor_normalizers: anchor.map(|anchor| [anchor.observation_norm, anchor.goal_norm]),
     };
     // The state goes last: a checkpoint is complete once state.json names its epoch.
     checkpoint::save_json(&checkpoint_dir.join("state.json"), &state)?;

@@ -4,8 +4,9 @@
 use std::sync::Arc;
 
 use dexcube_env::{Goal, GoalEnv, Info, Observation, Spaces, Transition};
+use dexcube_rl::params::NamedTensor;
 use dexcube_rl::point_mass::{PointGoal, PointMassEnv};
-use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
+use dexcube_rl::{Agent, DdpgHerConfig, Policy, TrainOptions, train};
 
 fn config() -> DdpgHerConfig {
     DdpgHerConfig {
@@ -33,6 +34,27 @@ fn options(dir: &std::path::Path, epochs: usize, resume: bool) -> TrainOptions {
         label: "point mass".into(),
         metadata: serde_json::json!({"env": "point mass"}),
     }
+}
+
+/// Parameters in name order, to compare networks whatever order they were read in.
+fn by_name(mut tensors: Vec<NamedTensor>) -> Vec<NamedTensor> {
+    tensors.sort_by(|a, b| a.name.cmp(&b.name));
+    tensors
+}
+
+/// The agent's and the policy's actions on the first state of point-mass episodes seeded
+/// 0, 1, … `episodes` - 1.
+fn first_actions(agent: &Agent, policy: &Policy, episodes: u64) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let mut env = PointMassEnv::default();
+    (0..episodes)
+        .map(|seed| {
+            let (obs, _) = env.reset(Some(seed));
+            let from_agent = agent
+                .act(&obs.observation, &obs.desired_goal, 1, None)
+                .remove(0);
+            (from_agent, policy.act(&obs.observation, &obs.desired_goal))
+        })
+        .collect()
 }
 
 fn fresh_dir(name: &str) -> std::path::PathBuf {
@@ -134,10 +156,6 @@ fn a_warm_start_carries_the_networks_into_a_new_run() {
         dexcube_rl::checkpoint::load_tensors(&source.join("checkpoint/actor.safetensors")).unwrap();
     let run = train(PointMassEnv::default, frozen.clone(), &warm).unwrap();
     assert_eq!(run.metrics.len(), 1, "a new run counts its own epochs");
-    let by_name = |mut tensors: Vec<dexcube_rl::params::NamedTensor>| {
-        tensors.sort_by(|a, b| a.name.cmp(&b.name));
-        tensors
-    };
     assert_eq!(
         by_name(run.agent.networks()[0].clone()),
         by_name(saved),
@@ -183,11 +201,8 @@ fn a_warm_start_carries_the_networks_into_a_new_run() {
 fn a_warm_start_takes_the_actor_of_a_named_policy_and_can_hold_it() {
     let source = fresh_dir("dexcube-rl-warm-actor-source");
     train(PointMassEnv::default, config(), &options(&source, 3, false)).unwrap();
-    let tensors = |path: std::path::PathBuf| {
-        let mut tensors = dexcube_rl::checkpoint::load_tensors(&path).unwrap();
-        tensors.sort_by(|a, b| a.name.cmp(&b.name));
-        tensors
-    };
+    let tensors =
+        |path: std::path::PathBuf| by_name(dexcube_rl::checkpoint::load_tensors(&path).unwrap());
     let snapshot = source.join("snapshots/epoch-0001");
     let (earlier, last) = (
         tensors(snapshot.with_extension("safetensors")),
@@ -202,9 +217,7 @@ fn a_warm_start_takes_the_actor_of_a_named_policy_and_can_hold_it() {
         ..options(&dir, 1, false)
     };
     let run = train(PointMassEnv::default, config(), &held).unwrap();
-    let [mut actor, mut critic, ..] = run.agent.networks();
-    actor.sort_by(|a, b| a.name.cmp(&b.name));
-    critic.sort_by(|a, b| a.name.cmp(&b.name));
+    let [actor, critic, ..] = run.agent.networks().map(by_name);
     assert_eq!(
         actor, earlier,
         "the named policy's actor, held through the epoch"
@@ -223,12 +236,8 @@ fn a_warm_start_takes_the_actor_of_a_named_policy_and_can_hold_it() {
 fn a_policy_alone_warm_starts_the_actor_and_an_anchor_holds_it_near() {
     let source = fresh_dir("dexcube-rl-anchor-source");
     train(PointMassEnv::default, config(), &options(&source, 1, false)).unwrap();
-    let sorted = |mut tensors: Vec<dexcube_rl::params::NamedTensor>| {
-        tensors.sort_by(|a, b| a.name.cmp(&b.name));
-        tensors
-    };
     let start =
-        sorted(dexcube_rl::checkpoint::load_tensors(&source.join("policy.safetensors")).unwrap());
+        by_name(dexcube_rl::checkpoint::load_tensors(&source.join("policy.safetensors")).unwrap());
     let from_policy = |name: &str, anchor: f64| {
         let dir = fresh_dir(name);
         let options = TrainOptions {
@@ -249,7 +258,7 @@ fn a_policy_alone_warm_starts_the_actor_and_an_anchor_holds_it_near() {
     };
     let run = train(PointMassEnv::default, frozen, &held).unwrap();
     assert_eq!(
-        sorted(run.agent.networks()[0].clone()),
+        by_name(run.agent.networks()[0].clone()),
         start,
         "the actor is the policy's"
     );
@@ -263,20 +272,9 @@ fn a_policy_alone_warm_starts_the_actor_and_an_anchor_holds_it_near() {
             ..config
         };
         let run = train(PointMassEnv::default, config, &options).unwrap();
-        let mut env = PointMassEnv::default();
-        let distance: f64 = (0..20)
-            .map(|seed| {
-                let (obs, _) = env.reset(Some(seed));
-                let now = run
-                    .agent
-                    .act(&obs.observation, &obs.desired_goal, 1, None)
-                    .remove(0);
-                let then = started.act(&obs.observation, &obs.desired_goal);
-                now.iter()
-                    .zip(&then)
-                    .map(|(a, b)| (a - b).abs())
-                    .sum::<f64>()
-            })
+        let distance: f64 = first_actions(&run.agent, &started, 20)
+            .iter()
+            .flat_map(|(now, then)| now.iter().zip(then).map(|(a, b)| (a - b).abs()))
             .sum();
         (dir, distance)
     };
@@ -300,7 +298,7 @@ fn a_policy_alone_warm_starts_the_actor_and_an_anchor_holds_it_near() {
     assert_eq!(run.metrics.len(), 4);
     let anchor = run.agent.anchor().unwrap();
     assert_eq!(
-        sorted(anchor.actor.clone()),
+        by_name(anchor.actor.clone()),
         start,
         "the resumed run holds the same anchor"
     );
@@ -442,14 +440,7 @@ fn a_saved_policy_acts_like_the_agent_it_came_from() {
     let dir = fresh_dir("dexcube-rl-policy");
     let trained = train(PointMassEnv::default, config(), &options(&dir, 1, false)).unwrap();
     let policy = Policy::load(&dir.join("policy"), &burn::prelude::Device::flex()).unwrap();
-    let mut env = PointMassEnv::default();
-    for seed in 0..5 {
-        let (obs, _) = env.reset(Some(seed));
-        let from_agent = trained
-            .agent
-            .act(&obs.observation, &obs.desired_goal, 1, None)
-            .remove(0);
-        let from_policy = policy.act(&obs.observation, &obs.desired_goal);
+    for (from_agent, from_policy) in first_actions(&trained.agent, &policy, 5) {
         for (a, b) in from_agent.iter().zip(&from_policy) {
             assert!((a - b).abs() < 1e-5, "{from_agent:?} vs {from_policy:?}");
         }
