@@ -107,21 +107,7 @@ pub fn run(args: RlArgs) -> anyhow::Result<ExitCode> {
         test_episodes: envs,
         ..config
     };
-    let options = TrainOptions {
-        epochs: 1,
-        envs,
-        threads,
-        seed,
-        out_dir: None,
-        resume: false,
-        init_from: None,
-        init_actor: None,
-        snapshot_every: 0,
-        critic_only_epochs: 0,
-        progress: false,
-        label: "bench".into(),
-        metadata: serde_json::json!({}),
-    };
+    let options = TrainOptions::in_memory("bench", 1, envs, threads, seed);
     let trained = train(
         || CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper)),
         short,

@@ -72,6 +72,28 @@ pub struct TrainOptions {
     pub metadata: serde_json::Value,
 }
 
+impl TrainOptions {
+    /// A fresh run of `epochs` kept in memory: no warm start, resume, snapshots, progress bar
+    /// or metadata. What tests and benchmarks train with; set `out_dir` and the rest on top.
+    pub fn in_memory(label: &str, epochs: usize, envs: usize, threads: usize, seed: u64) -> Self {
+        TrainOptions {
+            epochs,
+            envs,
+            threads,
+            seed,
+            out_dir: None,
+            resume: false,
+            init_from: None,
+            init_actor: None,
+            snapshot_every: 0,
+            critic_only_epochs: 0,
+            progress: false,
+            label: label.into(),
+            metadata: serde_json::json!({}),
+        }
+    }
+}
+
 /// One epoch's record, a row of `metrics.csv`.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct EpochMetrics {

@@ -20,19 +20,11 @@ fn config() -> DdpgHerConfig {
 
 fn options(dir: &std::path::Path, epochs: usize, resume: bool) -> TrainOptions {
     TrainOptions {
-        epochs,
-        envs: 2,
-        threads: 1,
-        seed: 3,
         out_dir: Some(dir.to_path_buf()),
         resume,
-        init_from: None,
-        init_actor: None,
         snapshot_every: 2,
-        critic_only_epochs: 0,
-        progress: false,
-        label: "point mass".into(),
         metadata: serde_json::json!({"env": "point mass"}),
+        ..TrainOptions::in_memory("point mass", epochs, 2, 1, 3)
     }
 }
 

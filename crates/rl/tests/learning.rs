@@ -18,21 +18,7 @@ fn small_config(her: bool) -> DdpgHerConfig {
 }
 
 fn options(epochs: usize) -> TrainOptions {
-    TrainOptions {
-        epochs,
-        envs: 2,
-        threads: 1,
-        seed: 1,
-        out_dir: None,
-        resume: false,
-        init_from: None,
-        init_actor: None,
-        snapshot_every: 0,
-        critic_only_epochs: 0,
-        progress: false,
-        label: "point mass".into(),
-        metadata: serde_json::json!({}),
-    }
+    TrainOptions::in_memory("point mass", epochs, 2, 1, 1)
 }
 
 #[test]
