@@ -59,8 +59,9 @@ pub struct TrainArgs {
     #[arg(long)]
     quarter_goals: bool,
     /// Train only the critic for this run's first N epochs, the actor held as loaded: for a
-    /// warm start (--init) onto another object or success test (0: DDPG as published).
-    #[arg(long, default_value_t = 0, value_name = "N")]
+    /// warm start (--init) onto another object or success test (0: DDPG as published). A
+    /// resumed run keeps the number it began with.
+    #[arg(long, default_value_t = 0, value_name = "N", conflicts_with = "resume")]
     critic_only_epochs: usize,
     /// Keep the policy of every this many epochs under DIR/snapshots (0: none).
     #[arg(long, default_value_t = 5)]

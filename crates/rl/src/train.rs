@@ -5,7 +5,8 @@
 //!
 //! - `checkpoint/`: all four networks and `state.json` (config, normalisers, progress),
 //!   from which `resume` continues. Adam's moments and the replay buffer start empty on
-//!   resume; the networks, normalisers, metrics and episode count carry over. The same
+//!   resume; the networks, normalisers, metrics and episode count carry over, and so does how
+//!   the run began (its warm start and critic-only epochs, which only its first call names). The same
 //!   checkpoint can also warm-start a new run (`init_from`) on a changed goal or success
 //!   test: networks and normalisers carry over, everything else starts afresh.
 //! - `best.safetensors` + `best.json`: the policy with the highest test success so far.
@@ -62,7 +63,8 @@ pub struct TrainOptions {
     /// The run's first epochs in which only the critic learns ([`Learners::CriticOnly`]):
     /// after a warm start onto another object or success test, the replay buffer and the
     /// optimisers' moments start empty, and an actor steered at once by a critic fitted to
-    /// a few episodes can lose what it knew (0: none, DDPG as published).
+    /// a few episodes can lose what it knew (0: none, DDPG as published). A resumed run keeps
+    /// the number its first call gave.
     pub critic_only_epochs: usize,
     /// Show a progress bar with ETA on stderr.
     pub progress: bool,
@@ -151,13 +153,37 @@ struct TrainState {
     observation_norm: Normalizer,
     goal_norm: Normalizer,
     metrics: Vec<EpochMetrics>,
-    /// The run this one was warm-started from, kept so a resumed run's cards still say so.
+    /// How the run began, kept so that a resumed run keeps it.
     #[serde(default)]
+    start: Option<RunStart>,
+    /// Older checkpoints kept only the run this one was warm-started from; their resumes take
+    /// the rest of [`RunStart`] from the resuming call.
+    #[serde(default, skip_serializing)]
     init_from: Option<PathBuf>,
     /// The anchor's normalisers (observation, goal), for a run fine-tuned with one; its
     /// weights are `checkpoint/anchor.safetensors`.
     #[serde(default)]
     anchor_normalizers: Option<[Normalizer; 2]>,
+}
+
+/// What a run's first call set that its resumes keep, since only that call is given them: the
+/// run it was warm-started from, the card's environment facts (which name a policy the actor
+/// came from) and the critic-only epochs.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+struct RunStart {
+    init_from: Option<PathBuf>,
+    environment: serde_json::Value,
+    critic_only_epochs: usize,
+}
+
+impl RunStart {
+    fn of(options: &TrainOptions) -> Self {
+        RunStart {
+            init_from: options.init_from.clone(),
+            environment: options.metadata.clone(),
+            critic_only_epochs: options.critic_only_epochs,
+        }
+    }
 }
 
 #[derive(Debug)]
@@ -225,12 +251,12 @@ pub fn train<E: GoalEnv>(
     let mut agent = Agent::new(dims, config.clone(), &Device::flex(), options.seed);
     let mut buffer = HerBuffer::new(dims, config.buffer_size, config.future_probability(), goal);
     let mut metrics: Vec<EpochMetrics> = Vec::new();
-    let mut init_from = options.init_from.clone();
+    let mut start = RunStart::of(options);
     if let (true, Some(dir)) = (options.resume, &options.out_dir) {
-        let resumed_from;
-        (metrics, resumed_from) = resume(&mut agent, dir, options)?;
+        let resumed_start;
+        (metrics, resumed_start) = resume(&mut agent, dir, options)?;
         if !metrics.is_empty() {
-            init_from = resumed_from;
+            start = resumed_start;
         }
     }
     if metrics.is_empty() {
@@ -266,7 +292,7 @@ pub fn train<E: GoalEnv>(
         let (mut rollout_s, mut learning_s) = (0.0, 0.0);
         let (mut train_successes, mut train_episodes, mut steps) = (0, 0, 0);
         let mut stats = StepStats::default();
-        let learners = if epoch < options.critic_only_epochs {
+        let learners = if epoch < start.critic_only_epochs {
             Learners::CriticOnly
         } else {
             Learners::ActorAndCritic
@@ -354,14 +380,7 @@ pub fn train<E: GoalEnv>(
         best = best.max(row.test_success);
         metrics.push(row);
         if let Some(dir) = &options.out_dir {
-            save_epoch(
-                &agent,
-                dir,
-                options,
-                init_from.as_deref(),
-                &metrics,
-                improved,
-            )?;
+            save_epoch(&agent, dir, options, &start, &metrics, improved)?;
         }
     }
     bar.finish();
@@ -386,13 +405,13 @@ fn progress_bar(options: &TrainOptions, cycles: usize, done_epochs: usize) -> Pr
 
 fn card_metadata(
     options: &TrainOptions,
-    init_from: Option<&Path>,
+    start: &RunStart,
     metrics: &[EpochMetrics],
 ) -> serde_json::Value {
     let last = metrics.last();
     serde_json::json!({
         "label": options.label,
-        "environment": options.metadata,
+        "environment": start.environment,
         "seed": options.seed,
         "envs": options.envs,
         "epochs": metrics.len(),
@@ -401,7 +420,7 @@ fn card_metadata(
         "updates": last.map_or(0, |m| m.updates),
         "wall_s": last.map_or(0.0, |m| m.wall_s),
         "test_success": last.map_or(0.0, |m| m.test_success),
-        "init_from": init_from.map(|d| d.display().to_string()),
+        "init_from": start.init_from.as_ref().map(|d| d.display().to_string()),
     })
 }
 
@@ -409,7 +428,7 @@ fn save_epoch(
     agent: &Agent,
     dir: &Path,
     options: &TrainOptions,
-    init_from: Option<&Path>,
+    start: &RunStart,
     metrics: &[EpochMetrics],
     improved: bool,
 ) -> Result<(), TrainError> {
@@ -432,7 +451,8 @@ fn save_epoch(
         observation_norm: agent.observation_norm.clone(),
         goal_norm: agent.goal_norm.clone(),
         metrics: metrics.to_vec(),
-        init_from: init_from.map(Path::to_path_buf),
+        start: Some(start.clone()),
+        init_from: None,
         anchor_normalizers: anchor.map(|anchor| [anchor.observation_norm, anchor.goal_norm]),
     };
     // The state goes last: a checkpoint is complete once state.json names its epoch.
@@ -445,7 +465,7 @@ fn save_epoch(
     if options.snapshot_every > 0 && epochs.is_multiple_of(options.snapshot_every) {
         prefixes.push(dir.join(format!("snapshots/epoch-{:04}", epochs - 1)));
     }
-    Policy::save(agent, &prefixes, card_metadata(options, init_from, metrics))?;
+    Policy::save(agent, &prefixes, card_metadata(options, start, metrics))?;
     let csv: Vec<String> = std::iter::once(CSV_HEADER.to_string())
         .chain(metrics.iter().map(EpochMetrics::csv_row))
         .collect();
@@ -494,10 +514,10 @@ fn resume(
     agent: &mut Agent,
     dir: &Path,
     options: &TrainOptions,
-) -> Result<(Vec<EpochMetrics>, Option<PathBuf>), TrainError> {
+) -> Result<(Vec<EpochMetrics>, RunStart), TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
-        return Ok((Vec::new(), None));
+        return Ok((Vec::new(), RunStart::of(options)));
     }
     let resumed = load_checkpoint(agent, &checkpoint_dir, None, |state, agent| {
         let at = checkpoint_dir.display();
@@ -538,7 +558,11 @@ fn resume(
             .load_anchor(saved)
             .map_err(|e| mismatch(&path, e.to_string()))?;
     }
-    Ok((resumed.metrics, resumed.init_from))
+    let start = resumed.start.unwrap_or(RunStart {
+        init_from: resumed.init_from,
+        ..RunStart::of(options)
+    });
+    Ok((resumed.metrics, start))
 }
 
 /// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had

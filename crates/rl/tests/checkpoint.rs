@@ -115,6 +115,33 @@ fn a_run_writes_its_files_and_resumes_where_it_stopped() {
     assert!(err.to_string().contains("is a run of point mass"), "{err}");
 }
 
+#[test]
+fn a_resumed_run_keeps_how_it_began() {
+    // The first call names the warm start and the critic-only epochs; a resume names neither.
+    let dir = fresh_dir("dexcube-rl-resume-start");
+    let began = TrainOptions {
+        critic_only_epochs: 3,
+        metadata: serde_json::json!({"env": "point mass", "init_actor": "models/somewhere"}),
+        ..options(&dir, 1, false)
+    };
+    train(PointMassEnv::default, config(), &began).unwrap();
+    let held =
+        dexcube_rl::checkpoint::load_tensors(&dir.join("checkpoint/actor.safetensors")).unwrap();
+    let resumed = train(PointMassEnv::default, config(), &options(&dir, 3, true)).unwrap();
+    let [actor, ..] = resumed.agent.networks();
+    let change = dexcube_rl::params::l1_distance(&by_name(held), &by_name(actor));
+    assert_eq!(
+        change, 0.0,
+        "epochs 2 and 3 are still the run's critic-only epochs"
+    );
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap()).unwrap();
+    assert_eq!(
+        card["metadata"]["environment"]["init_actor"], "models/somewhere",
+        "the resumed run's card names the warm start"
+    );
+}
+
 /// Trains a one-epoch source run in `NAME-source`, and returns it with the folder of a new run
 /// (`NAME`), the options that warm-start that run from the source, and a configuration
 /// without batches. Another configuration is fine for a new run; with no batches, learning
