@@ -13,12 +13,20 @@ pub struct NamedTensor {
     pub values: Vec<f32>,
 }
 
-/// How far apart two sets of the same parameters are: the sum of absolute differences (for
-/// tests and diagnostics: whether training moved a network).
+/// How far apart two sets of the same parameters are: the sum of absolute differences,
+/// parameters paired by name whatever order each set is in (a safetensors file is read back in
+/// its own order). For tests and diagnostics: whether training moved a network.
 pub fn l1_distance(a: &[NamedTensor], b: &[NamedTensor]) -> f32 {
-    a.iter()
-        .zip(b)
+    fn by_name(set: &[NamedTensor]) -> Vec<&NamedTensor> {
+        let mut sorted: Vec<&NamedTensor> = set.iter().collect();
+        sorted.sort_by(|x, y| x.name.cmp(&y.name));
+        sorted
+    }
+    by_name(a)
+        .into_iter()
+        .zip(by_name(b))
         .map(|(x, y)| {
+            assert_eq!(x.name, y.name, "the same parameters on both sides");
             x.values
                 .iter()
                 .zip(&y.values)

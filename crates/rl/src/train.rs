@@ -252,12 +252,10 @@ pub fn train<E: GoalEnv>(
     let mut buffer = HerBuffer::new(dims, config.buffer_size, config.future_probability(), goal);
     let mut metrics: Vec<EpochMetrics> = Vec::new();
     let mut start = RunStart::of(options);
-    if let (true, Some(dir)) = (options.resume, &options.out_dir) {
-        let resumed_start;
-        (metrics, resumed_start) = resume(&mut agent, dir, options)?;
-        if !metrics.is_empty() {
-            start = resumed_start;
-        }
+    if let (true, Some(dir)) = (options.resume, &options.out_dir)
+        && let Some(resumed) = resume(&mut agent, dir, options)?
+    {
+        (metrics, start) = resumed;
     }
     if metrics.is_empty() {
         match (&options.init_from, &options.init_actor) {
@@ -514,10 +512,10 @@ fn resume(
     agent: &mut Agent,
     dir: &Path,
     options: &TrainOptions,
-) -> Result<(Vec<EpochMetrics>, RunStart), TrainError> {
+) -> Result<Option<(Vec<EpochMetrics>, RunStart)>, TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
-        return Ok((Vec::new(), RunStart::of(options)));
+        return Ok(None);
     }
     let resumed = load_checkpoint(agent, &checkpoint_dir, None, |state, agent| {
         let at = checkpoint_dir.display();
@@ -562,7 +560,7 @@ fn resume(
         init_from: resumed.init_from,
         ..RunStart::of(options)
     });
-    Ok((resumed.metrics, start))
+    Ok(Some((resumed.metrics, start)))
 }
 
 /// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had

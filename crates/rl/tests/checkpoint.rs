@@ -129,7 +129,7 @@ fn a_resumed_run_keeps_how_it_began() {
         dexcube_rl::checkpoint::load_tensors(&dir.join("checkpoint/actor.safetensors")).unwrap();
     let resumed = train(PointMassEnv::default, config(), &options(&dir, 3, true)).unwrap();
     let [actor, ..] = resumed.agent.networks();
-    let change = dexcube_rl::params::l1_distance(&by_name(held), &by_name(actor));
+    let change = dexcube_rl::params::l1_distance(&held, &actor);
     assert_eq!(
         change, 0.0,
         "epochs 2 and 3 are still the run's critic-only epochs"
