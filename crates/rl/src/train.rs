@@ -6,8 +6,8 @@
 //! - `checkpoint/`: all four networks and `state.json` (config, normalisers, progress),
 //!   from which `resume` continues. Adam's moments and the replay buffer start empty on
 //!   resume; the networks, normalisers, metrics and episode count carry over, and so does how
-//!   the run began (its warm start and critic-only epochs, which only its first call names). The same
-//!   checkpoint can also warm-start a new run (`init_from`) on a changed goal or success
+//!   the run began (its warm start and critic-only epochs, which only its first call names).
+//!   The same checkpoint can also warm-start a new run (`init_from`) on a changed goal or success
 //!   test: networks and normalisers carry over, everything else starts afresh.
 //! - `best.safetensors` + `best.json`: the policy with the highest test success so far.
 //! - `policy.safetensors` + `policy.json`: the latest policy.
@@ -169,7 +169,7 @@ struct TrainState {
 /// What a run's first call set that its resumes keep, since only that call is given them: the
 /// run it was warm-started from, the card's environment facts (which name a policy the actor
 /// came from) and the critic-only epochs.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 struct RunStart {
     init_from: Option<PathBuf>,
     environment: serde_json::Value,
@@ -250,13 +250,11 @@ pub fn train<E: GoalEnv>(
     );
     let mut agent = Agent::new(dims, config.clone(), &Device::flex(), options.seed);
     let mut buffer = HerBuffer::new(dims, config.buffer_size, config.future_probability(), goal);
-    let mut metrics: Vec<EpochMetrics> = Vec::new();
-    let mut start = RunStart::of(options);
-    if let (true, Some(dir)) = (options.resume, &options.out_dir)
-        && let Some(resumed) = resume(&mut agent, dir, options)?
-    {
-        (metrics, start) = resumed;
-    }
+    let resumed = match (options.resume, &options.out_dir) {
+        (true, Some(dir)) => resume(&mut agent, dir, options)?,
+        _ => None,
+    };
+    let (mut metrics, start) = resumed.unwrap_or_else(|| (Vec::new(), RunStart::of(options)));
     if metrics.is_empty() {
         match (&options.init_from, &options.init_actor) {
             (Some(dir), actor_from) => warm_start(&mut agent, dir, actor_from.as_deref())?,
@@ -556,7 +554,7 @@ fn resume(
             .load_anchor(saved)
             .map_err(|e| mismatch(&path, e.to_string()))?;
     }
-    let start = resumed.start.unwrap_or(RunStart {
+    let start = resumed.start.unwrap_or_else(|| RunStart {
         init_from: resumed.init_from,
         ..RunStart::of(options)
     });
