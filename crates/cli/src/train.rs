@@ -89,15 +89,40 @@ pub struct TrainArgs {
 }
 
 /// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
-/// trained on a machine that could not draw it (no fonts).
+/// trained on a machine that could not draw it (no fonts); or, given several runs and
+/// `--out`, draws their test success as a mean with a band of one standard deviation across
+/// seeds, a curve per environment (the paper's training-curve figures), with a CSV beside it.
 #[derive(Args)]
 pub struct PlotArgs {
-    /// The run's folder, as written by `dexcube train` (it holds checkpoint/state.json).
-    run: PathBuf,
+    /// Run folders, as written by `dexcube train` (each holds checkpoint/state.json).
+    #[arg(required = true)]
+    runs: Vec<PathBuf>,
+    /// Draw the runs across seeds into this PNG (and the same figures into its .csv).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 pub fn plot(args: PlotArgs) -> anyhow::Result<ExitCode> {
-    let path = dexcube_rl::train::replot(&args.run)?;
+    let path = match (&args.out, args.runs.as_slice()) {
+        (None, [run]) => dexcube_rl::train::replot(run)?,
+        (None, _) => bail!("several runs are drawn across seeds into one figure: pass --out PNG"),
+        (Some(out), runs) => {
+            let curves = dexcube_rl::seeds::seed_curves(runs)?;
+            for curve in &curves {
+                let last = curve.points.last().copied().unwrap_or_default();
+                println!(
+                    "{}: seeds {:?}, {} epochs in common, test success at {} episodes {:.2} ± {:.2}",
+                    curve.label,
+                    curve.seeds,
+                    curve.points.len(),
+                    last.0,
+                    last.1,
+                    last.2
+                );
+            }
+            dexcube_rl::seeds::plot_seed_curves(&curves, out)?
+        }
+    };
     println!("{}", path.display());
     Ok(ExitCode::SUCCESS)
 }

@@ -428,3 +428,62 @@ fn eval_stage_records_each_object_under_its_own_name() {
         "CubeRotEnv holds the rigid or the physical cube",
     );
 }
+
+/// `plot` draws committed runs as one curve per environment with a CSV of the figures, and
+/// refuses a seed given twice or several runs without a figure to draw them into.
+#[test]
+fn plot_draws_runs_across_seeds_and_refuses_a_seed_twice() {
+    let training = concat!(env!("CARGO_MANIFEST_DIR"), "/../../results/training/");
+    let run = |name: &str| format!("{training}{name}");
+    let (rot, rot_again, layer) = (
+        run("rot-pair-cube-square-anchor10-seed0"),
+        run("rot-pair-cube-square-anchor5-seed0"),
+        run("layer-Up-quarter-cube-square-anchor10-seed0"),
+    );
+    let out = std::env::temp_dir().join("dexcube-cli-plot/seeds.png");
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
+    let o = dexcube(&["plot", &rot, &layer, "--out", out.to_str().unwrap()], "");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::metadata(&out).unwrap().len() > 1000);
+    let csv = std::fs::read_to_string(out.with_extension("csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    let first = |label: &str| {
+        rows.iter()
+            .find(|r| r.starts_with(&format!("\"{label}")))
+            // The label is quoted (it holds commas); the fields after it are plain.
+            .map(|r| {
+                r[r.find("\",").unwrap() + 2..]
+                    .split(',')
+                    .map(str::to_string)
+                    .collect::<Vec<_>>()
+            })
+            .unwrap_or_else(|| panic!("no row for {label} in {csv}"))
+    };
+    // One seed each: the mean is that run's test success and the deviation 0. Fields:
+    // seeds, episodes, mean, deviation.
+    let rot_row = first("CubeRotEnv");
+    let layer_row = first("LayerOpEnv");
+    for row in [&rot_row, &layer_row] {
+        assert_eq!(row[0], "0");
+        assert_eq!(row[3], "0.0000");
+    }
+    let metrics = std::fs::read_to_string(format!("{rot}/metrics.csv")).unwrap();
+    let epoch0: Vec<&str> = metrics.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(rot_row[1], epoch0[1], "episodes of the first epoch");
+    let success: f64 = epoch0[4].parse().unwrap();
+    assert_eq!(rot_row[2], format!("{success:.4}"));
+
+    let o = dexcube(
+        &["plot", &rot, &rot_again, "--out", out.to_str().unwrap()],
+        "",
+    );
+    assert_clean_failure(&o, 2, "are both seed 0 of CubeRotEnv");
+    let o = dexcube(&["plot", &rot, &layer], "");
+    assert_clean_failure(&o, 2, "pass --out PNG");
+    let o = dexcube(
+        &["plot", "/nonexistent/run", "--out", out.to_str().unwrap()],
+        "",
+    );
+    assert_clean_failure(&o, 2, "is not a training run's folder");
+}

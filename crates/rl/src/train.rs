@@ -97,7 +97,7 @@ impl TrainOptions {
 }
 
 /// One epoch's record, a row of `metrics.csv`.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct EpochMetrics {
     pub epoch: usize,
     pub episodes: usize,
@@ -502,8 +502,34 @@ fn plot_learning_curve(
 /// Redraws the learning curve of the run in `dir` from its checkpoint, for a run trained
 /// where plots could not be drawn (a machine without fonts); returns the PNG's path.
 pub fn replot(dir: &Path) -> Result<PathBuf, TrainError> {
-    let state: TrainState = checkpoint::load_json(&dir.join("checkpoint").join("state.json"))?;
-    plot_learning_curve(dir, &state.label, state.seed, &state.metrics).map_err(TrainError::Plot)
+    let run = RunCurve::read(dir)?;
+    plot_learning_curve(dir, &run.label, run.seed, &run.metrics).map_err(TrainError::Plot)
+}
+
+/// A training run's learning curve, as its checkpoint keeps it.
+pub struct RunCurve {
+    pub label: String,
+    pub seed: u64,
+    pub metrics: Vec<EpochMetrics>,
+}
+
+impl RunCurve {
+    /// Reads the curve of the run in `dir` (from `checkpoint/state.json`).
+    pub fn read(dir: &Path) -> Result<RunCurve, TrainError> {
+        let path = dir.join("checkpoint").join("state.json");
+        if !path.exists() {
+            return Err(TrainError::Plot(format!(
+                "{} is not a training run's folder (it has no checkpoint/state.json)",
+                dir.display()
+            )));
+        }
+        let state: TrainState = checkpoint::load_json(&path)?;
+        Ok(RunCurve {
+            label: state.label,
+            seed: state.seed,
+            metrics: state.metrics,
+        })
+    }
 }
 
 fn resume(
