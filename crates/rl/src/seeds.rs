@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::checkpoint::{self, CheckpointError};
+use crate::checkpoint;
 use crate::plot::{Series, line_plot};
 use crate::train::{EpochMetrics, RunCurve, TrainError};
 
@@ -94,8 +94,7 @@ pub fn plot_seed_curves(curves: &[SeedCurve], out: &Path) -> Result<PathBuf, Tra
             );
         }
     }
-    checkpoint::write_atomically(&out.with_extension("csv"), csv.as_bytes())
-        .map_err(|e: CheckpointError| TrainError::Checkpoint(e))?;
+    checkpoint::write_atomically(&out.with_extension("csv"), csv.as_bytes())?;
     let series: Vec<Series> = curves
         .iter()
         .map(|curve| Series {
