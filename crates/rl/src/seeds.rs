@@ -43,7 +43,8 @@ pub fn across_seeds(runs: &[&[EpochMetrics]]) -> Result<Vec<(f64, f64, f64)>, St
 }
 
 /// Groups the runs in `dirs` by label, in the order each label first appears, and averages
-/// each group across its seeds. Two runs of one label with the same seed are refused.
+/// each group across its seeds. Two runs of one label with the same seed, or with different
+/// hyperparameters, are refused.
 pub fn seed_curves(dirs: &[PathBuf]) -> Result<Vec<SeedCurve>, TrainError> {
     let mut groups: Vec<(String, Vec<(PathBuf, RunCurve)>)> = Vec::new();
     for dir in dirs {
@@ -56,6 +57,16 @@ pub fn seed_curves(dirs: &[PathBuf]) -> Result<Vec<SeedCurve>, TrainError> {
                         twin.display(),
                         dir.display(),
                         run.seed,
+                        run.label
+                    )));
+                }
+                let (first, kin) = &members[0];
+                if kin.config != run.config {
+                    return Err(TrainError::Plot(format!(
+                        "{} and {} are runs of {} with different hyperparameters, not seeds of \
+                         one experiment: draw them in separate figures",
+                        first.display(),
+                        dir.display(),
                         run.label
                     )));
                 }

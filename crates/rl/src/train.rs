@@ -510,6 +510,7 @@ pub fn replot(dir: &Path) -> Result<PathBuf, TrainError> {
 pub struct RunCurve {
     pub label: String,
     pub seed: u64,
+    pub config: DdpgHerConfig,
     pub metrics: Vec<EpochMetrics>,
 }
 
@@ -527,6 +528,7 @@ impl RunCurve {
         Ok(RunCurve {
             label: state.label,
             seed: state.seed,
+            config: state.config,
             metrics: state.metrics,
         })
     }
