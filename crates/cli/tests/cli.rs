@@ -479,36 +479,22 @@ fn plot_draws_runs_across_seeds_and_refuses_a_seed_twice() {
         "",
     );
     assert_clean_failure(&o, 2, "are both seed 0 of CubeRotEnv");
-    // The same run under another seed, with its anchor changed: not a seed of one experiment.
+    // The same run under another seed is a second seed; with its anchor changed, it is not a
+    // seed of one experiment.
     let other = out.parent().unwrap().join("other-seed");
     std::fs::create_dir_all(other.join("checkpoint")).unwrap();
     let state = std::fs::read_to_string(format!("{rot}/checkpoint/state.json")).unwrap();
     let mut state: serde_json::Value = serde_json::from_str(&state).unwrap();
     state["seed"] = 1.into();
-    std::fs::write(other.join("checkpoint/state.json"), state.to_string()).unwrap();
-    let o = dexcube(
-        &[
-            "plot",
-            &rot,
-            other.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        "",
-    );
+    let plot_beside_rot = |state: &serde_json::Value| {
+        std::fs::write(other.join("checkpoint/state.json"), state.to_string()).unwrap();
+        let other = other.to_str().unwrap();
+        dexcube(&["plot", &rot, other, "--out", out.to_str().unwrap()], "")
+    };
+    let o = plot_beside_rot(&state);
     assert!(o.status.success(), "{}", stderr(&o));
     state["config"]["anchor"] = 5.0.into();
-    std::fs::write(other.join("checkpoint/state.json"), state.to_string()).unwrap();
-    let o = dexcube(
-        &[
-            "plot",
-            &rot,
-            other.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        "",
-    );
+    let o = plot_beside_rot(&state);
     assert_clean_failure(&o, 2, "with different hyperparameters");
     let o = dexcube(&["plot", &rot, &layer], "");
     assert_clean_failure(&o, 2, "pass --out PNG");
