@@ -46,40 +46,40 @@ pub fn across_seeds(runs: &[&[EpochMetrics]]) -> Result<Vec<(f64, f64, f64)>, St
 /// each group across its seeds. Two runs of one label with the same seed, or with different
 /// hyperparameters, are refused.
 pub fn seed_curves(dirs: &[PathBuf]) -> Result<Vec<SeedCurve>, TrainError> {
-    let mut groups: Vec<(String, Vec<(PathBuf, RunCurve)>)> = Vec::new();
+    let mut groups: Vec<Vec<(&PathBuf, RunCurve)>> = Vec::new();
     for dir in dirs {
         let run = RunCurve::read(dir)?;
-        match groups.iter_mut().find(|(label, _)| *label == run.label) {
-            Some((_, members)) => {
-                if let Some((twin, _)) = members.iter().find(|(_, m)| m.seed == run.seed) {
-                    return Err(TrainError::Plot(format!(
-                        "{} and {} are both seed {} of {}: pass each seed once",
-                        twin.display(),
-                        dir.display(),
-                        run.seed,
-                        run.label
-                    )));
-                }
-                let (first, kin) = &members[0];
-                if kin.config != run.config {
-                    return Err(TrainError::Plot(format!(
-                        "{} and {} are runs of {} with different hyperparameters, not seeds of \
-                         one experiment: draw them in separate figures",
-                        first.display(),
-                        dir.display(),
-                        run.label
-                    )));
-                }
-                members.push((dir.clone(), run));
-            }
-            None => groups.push((run.label.clone(), vec![(dir.clone(), run)])),
+        let Some(members) = groups.iter_mut().find(|g| g[0].1.label == run.label) else {
+            groups.push(vec![(dir, run)]);
+            continue;
+        };
+        if let Some((twin, _)) = members.iter().find(|(_, m)| m.seed == run.seed) {
+            return Err(TrainError::Plot(format!(
+                "{} and {} are both seed {} of {}: pass each seed once",
+                twin.display(),
+                dir.display(),
+                run.seed,
+                run.label
+            )));
         }
+        let (first, kin) = &members[0];
+        if kin.config != run.config {
+            return Err(TrainError::Plot(format!(
+                "{} and {} are runs of {} with different hyperparameters, not seeds of \
+                 one experiment: draw them in separate figures",
+                first.display(),
+                dir.display(),
+                run.label
+            )));
+        }
+        members.push((dir, run));
     }
     groups
         .into_iter()
-        .map(|(label, members)| {
+        .map(|members| {
             let metrics: Vec<&[EpochMetrics]> =
                 members.iter().map(|(_, m)| m.metrics.as_slice()).collect();
+            let label = members[0].1.label.clone();
             let points = across_seeds(&metrics)
                 .map_err(|message| TrainError::Plot(format!("{label}: {message}")))?;
             Ok(SeedCurve {
