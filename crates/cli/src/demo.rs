@@ -122,6 +122,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     let hooks = Hooks {
         watch: &mut watch,
         narrate: &mut narrate,
+        stage1_starts: None,
     };
     let job = (
         scramble.moves.as_slice(),

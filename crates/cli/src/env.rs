@@ -271,3 +271,35 @@ fn policy_name(policy: PolicyArg) -> &'static str {
         PolicyArg::Zero => "zero",
     }
 }
+
+/// Loads recorded Stage 1 starts for `scene`, refusing a file of another scene or another
+/// state size with a message that says so.
+pub fn starts_for(
+    path: &std::path::Path,
+    scene: &std::sync::Arc<Scene>,
+) -> anyhow::Result<std::sync::Arc<[dexcube_env::RecordedStart]>> {
+    let (starts, origin) = dexcube_rl::start_file::load_starts(path)?;
+    let name = scene.kind().name();
+    if origin.scene != name {
+        bail!(
+            "{} holds starts on the '{}' scene, not '{name}': starts are recorded on the physical \
+             cube, so train or evaluate with --object cube",
+            path.display(),
+            origin.scene
+        );
+    }
+    let size = dexcube_sim::Sim::new(scene.clone()).physics_state_size();
+    if let Some(start) = starts.iter().find(|s| s.state.len() != size) {
+        bail!(
+            "{} holds physics states of {} numbers where this scene's have {size}: it was \
+             recorded with another scene file or MuJoCo; record it again (its command: {})",
+            path.display(),
+            start.state.len(),
+            origin.command
+        );
+    }
+    if starts.is_empty() {
+        bail!("{} holds no starts", path.display());
+    }
+    Ok(starts.into())
+}

@@ -13,7 +13,7 @@ use dexcube_cube::{DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
     CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode, SimulatedEnv,
-    is_square,
+    StartMix, StartPick, is_square,
 };
 use dexcube_operator::OperatorConfig;
 use dexcube_operator::eval::{
@@ -22,10 +22,11 @@ use dexcube_operator::eval::{
 use dexcube_operator::stages::{Driving, PolicyStage1, PolicyStage2};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
+use dexcube_rl::start_file::{StartsOrigin, save_starts};
 use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::env::{EnvKind, original_object, suited};
+use crate::env::{EnvKind, original_object, starts_for, suited};
 
 /// Which operator runs the plan.
 #[derive(Args, Clone, Copy)]
@@ -240,6 +241,11 @@ pub struct EvalArgs {
     policies: PolicyArgs,
     #[command(flatten)]
     operator: OperatorArgs,
+    /// Also record where every Stage 1 run began (the physics state once the hand has
+    /// opened, and the pose asked for) into this file, for `train rot --starts` and
+    /// `eval-stage rot --starts`. Needs a fresh --out.
+    #[arg(long, value_name = "FILE")]
+    record_starts: Option<PathBuf>,
 }
 
 fn parse_distances(text: &str) -> anyhow::Result<Vec<usize>> {
@@ -317,6 +323,13 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
             files.layer.display()
         )
     };
+    if args.record_starts.is_some() && !results.is_empty() {
+        bail!(
+            "--record-starts records every cube of a run, and {} already holds {} of them: pass a new --out",
+            csv.display(),
+            results.len()
+        );
+    }
     eprintln!(
         "{} cubes to go ({} already in {})",
         jobs.len(),
@@ -333,6 +346,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     let scene = Scene::load(SceneKind::Cube)?;
     let resting = dexcube_operator::eval::resting_point()?;
     let shared = Mutex::new(std::mem::take(&mut results));
+    let recorded = Mutex::new(Vec::new());
     let save = |results: &[CubeResult]| -> anyhow::Result<()> {
         let mut sorted = results.to_vec();
         sorted.sort_by_key(|r| (!r.rollback, r.distance, r.index));
@@ -354,12 +368,15 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         |stages, k| {
             let (d, i, rollback, moves) = &jobs[k];
             let seed = args.seed ^ ((*d as u64) << 40) ^ ((*i as u64) << 8) ^ (*rollback as u64);
+            let mut starts = Vec::new();
             let hooks = Hooks {
                 watch: &mut |_| {},
                 narrate: &mut |_| {},
+                stage1_starts: args.record_starts.is_some().then_some(&mut starts),
             };
             let job = (moves.as_slice(), args.operator.config(*rollback), seed);
             let outcome = run_cube(stages, &scene, &table_all, job, hooks);
+            recorded.lock().expect("lock").push((k, starts));
             let row = CubeResult {
                 distance: *d,
                 index: *i,
@@ -386,6 +403,22 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     done?;
     let results = shared.into_inner().expect("lock");
     save(&results)?;
+    if let Some(path) = &args.record_starts {
+        let mut recorded = recorded.into_inner().expect("lock");
+        recorded.sort_by_key(|(k, _)| *k);
+        let starts: Vec<_> = recorded.into_iter().flat_map(|(_, s)| s).collect();
+        let origin = StartsOrigin {
+            scene: SceneKind::Cube.name().to_string(),
+            command: format!("{} --record-starts {}", command(&results), path.display()),
+        };
+        save_starts(path, &starts, &origin)?;
+        let dropped = starts.iter().filter(|s| s.dropped).count();
+        eprintln!(
+            "recorded {} Stage 1 starts ({dropped} of which the policy dropped the cube from) in {}",
+            starts.len(),
+            path.display()
+        );
+    }
     let rows = table(&results, &distances);
     if let Err(e) = plot(&rows, &args.out) {
         eprintln!("warning: no plot: {e}");
@@ -492,8 +525,13 @@ pub struct EvalStageArgs {
     #[arg(long)]
     object: Option<ObjectKind>,
     /// Also write the result into the policy's JSON card, as its evaluation.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "starts")]
     record: bool,
+    /// rot only: begin episode k from recorded start k of this file (made by `eval
+    /// --record-starts`), where the operator handed Stage 1 the cube, rather than from a
+    /// fresh placement seeded seed + k. Runs the first min(--episodes, starts) of them.
+    #[arg(long, value_name = "FILE")]
+    starts: Option<PathBuf>,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -634,18 +672,38 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         Some(object) => suited(args.stage, object)?,
         None => trained,
     };
-    let bar = ProgressBar::new(args.episodes as u64);
     let scene = Scene::load(object.scene())?;
+    let starts = match (&args.starts, args.stage) {
+        (None, _) => None,
+        (Some(path), EnvKind::Rot) => Some(starts_for(path, &scene)?),
+        (Some(_), EnvKind::Layer) => bail!("--starts are Stage 1's: use them with eval-stage rot"),
+    };
+    let episodes = starts
+        .as_ref()
+        .map_or(args.episodes, |s| args.episodes.min(s.len()));
+    // Starts from which the recorded policy dropped the cube, and this one did too.
+    let recorded_drops = starts.as_ref().map_or(0, |s| {
+        s[..episodes].iter().filter(|start| start.dropped).count()
+    });
+    let drops_again = AtomicUsize::new(0);
+    let bar = ProgressBar::new(episodes as u64);
     in_parallel(
         args.threads,
-        args.episodes,
+        episodes,
         || -> anyhow::Result<(Policy, Box<dyn SimulatedEnv>)> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
             let env: Box<dyn SimulatedEnv> = match args.stage {
-                EnvKind::Rot => Box::new(CubeRotEnv::with_scene(
-                    scene.clone(),
-                    PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?,
-                )),
+                EnvKind::Rot => {
+                    let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
+                    let env = CubeRotEnv::with_scene(scene.clone(), goal);
+                    Box::new(match &starts {
+                        Some(starts) => env.with_starts(StartMix {
+                            starts: starts.clone(),
+                            pick: StartPick::Numbered,
+                        }),
+                        None => env,
+                    })
+                }
                 EnvKind::Layer => Box::new(
                     LayerOpEnv::with_scene(
                         scene.clone(),
@@ -658,10 +716,17 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             Ok((policy, env))
         },
         |(policy, env), k| {
-            let trace = episode(env.as_mut(), policy, args.seed + k as u64, thresholds);
+            let seed = match starts {
+                Some(_) => k as u64,
+                None => args.seed + k as u64,
+            };
+            let trace = episode(env.as_mut(), policy, seed, thresholds);
             let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);
+            if ending == Ending::Dropped && starts.as_ref().is_some_and(|s| s[k].dropped) {
+                drops_again.fetch_add(1, Ordering::Relaxed);
+            }
             if ending == Ending::Success && !trace.square {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
             }
@@ -677,8 +742,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let counts = endings.map(AtomicUsize::into_inner);
     let wins = counts[Ending::Success as usize];
-    let (lo, hi) = wilson_interval(wins, args.episodes);
-    let rate = wins as f64 / args.episodes as f64;
+    let (lo, hi) = wilson_interval(wins, episodes);
+    let rate = wins as f64 / episodes as f64;
     let what = match args.stage {
         EnvKind::Rot => format!(
             "Stage 1 (CubeRotEnv, {} mode, {} cube)",
@@ -693,10 +758,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             object.name()
         ),
     };
+    let from = match &args.starts {
+        Some(path) => format!("from the recorded starts in {}", path.display()),
+        None => format!("seed {}", args.seed),
+    };
     println!(
-        "{what}: {wins}/{} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), seed {}, policy {}",
-        args.episodes,
-        args.seed,
+        "{what}: {wins}/{episodes} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), {from}, policy {}",
         prefix.display()
     );
     for ending in Ending::ALL.into_iter().skip(1) {
@@ -715,6 +782,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         println!(
             "  at the goal for {steps} step(s) running at some point: {}",
             count.load(Ordering::Relaxed)
+        );
+    }
+    if starts.is_some() {
+        println!(
+            "  starts from which the recorded policy dropped the cube: {recorded_drops}; this one dropped it from {} of them",
+            drops_again.into_inner()
         );
     }
     if args.record {

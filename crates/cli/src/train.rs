@@ -7,11 +7,11 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{CubeRotEnv, LayerOpEnv};
+use dexcube_env::{CubeRotEnv, LayerOpEnv, StartMix, StartPick};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
 use dexcube_sim::Scene;
 
-use crate::env::{EnvChoice, EnvKind};
+use crate::env::{EnvChoice, EnvKind, starts_for};
 
 /// How training collects experience, shared by `train` and `bench rl`. Eight environments
 /// on two threads balance physics against the 40 batches of a cycle on a 2-core machine.
@@ -86,6 +86,14 @@ pub struct TrainArgs {
     /// Train without Hindsight Experience Replay (plain DDPG), for ablations.
     #[arg(long)]
     no_her: bool,
+    /// rot on the physical cube: begin a share of episodes (--start-share) from the Stage 1
+    /// starts recorded in this file (`dexcube eval --record-starts`), where the operator hands
+    /// the cube over, rather than from a fresh placement. Give it again to resume.
+    #[arg(long, value_name = "FILE")]
+    starts: Option<PathBuf>,
+    /// With --starts, the probability that an episode begins from one of them.
+    #[arg(long, default_value_t = 0.5, value_name = "P", requires = "starts")]
+    start_share: f64,
 }
 
 /// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
@@ -141,6 +149,15 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     }
     let object = args.choice.object()?;
     let square = args.choice.square()?;
+    if args.starts.is_some() && matches!(args.choice.env, EnvKind::Layer) {
+        bail!("--starts are Stage 1's: use them with train rot --object cube");
+    }
+    if !(0.0..=1.0).contains(&args.start_share) {
+        bail!(
+            "--start-share must be between 0 and 1, not {}",
+            args.start_share
+        );
+    }
     let suffix = args
         .choice
         .named_object()?
@@ -222,6 +239,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
             "critic_only_epochs": args.critic_only_epochs,
             "init_actor": args.init_actor.as_ref().map(|p| p.display().to_string()),
+            "starts": args.starts.as_ref().map(|p| p.display().to_string()),
+            "start_share": args.starts.as_ref().map(|_| args.start_share),
         }),
     };
     eprintln!(
@@ -234,11 +253,21 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let trained = match args.choice.env {
         EnvKind::Rot => {
             let goal = args.choice.rot_goal()?;
-            train(
-                || CubeRotEnv::with_scene(scene.clone(), goal),
-                config,
-                &options,
-            )?
+            let starts = match &args.starts {
+                Some(path) => Some(StartMix {
+                    starts: starts_for(path, &scene)?,
+                    pick: StartPick::Share(args.start_share),
+                }),
+                None => None,
+            };
+            let make = || {
+                let env = CubeRotEnv::with_scene(scene.clone(), goal);
+                match &starts {
+                    Some(mix) => env.with_starts(mix.clone()),
+                    None => env,
+                }
+            };
+            train(make, config, &options)?
         }
         EnvKind::Layer => {
             let (layer_move, goal) = (args.choice.layer_move, args.choice.layer_goal()?);

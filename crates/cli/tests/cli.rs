@@ -236,6 +236,88 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     assert!(md.contains("--seed 5 --rot-policy"), "{md}");
 }
 
+/// `eval --record-starts` keeps where each Stage 1 run began, and `eval-stage rot --starts`
+/// runs the policy from them; a file that holds no starts, or starts for Stage 2, is refused.
+#[test]
+fn eval_records_stage_1_starts_that_eval_stage_runs_from() {
+    let dir = std::env::temp_dir().join("dexcube-cli-starts");
+    let _ = std::fs::remove_dir_all(&dir);
+    let starts = dir.join("starts.safetensors");
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let policies = [
+        "--rot-policy",
+        rot.to_str().unwrap(),
+        "--layer-policy",
+        layer.to_str().unwrap(),
+    ];
+    let o = dexcube(
+        &[
+            &[
+                "eval",
+                "--per-distance",
+                "1",
+                "--distances",
+                "4",
+                "--rollback-only",
+                "--threads",
+                "1",
+                "--out",
+                dir.join("table").to_str().unwrap(),
+                "--record-starts",
+                starts.to_str().unwrap(),
+            ][..],
+            &policies,
+        ]
+        .concat(),
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(dir.join("table.csv")).unwrap();
+    let row: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    // Every Stage 1 run that kept the cube began somewhere, and so did one that dropped it
+    // after the hand had opened (20 steps).
+    let dropped_later = row[8]
+        .strip_prefix("Dropped in Stage 1 at step ")
+        .is_some_and(|step| step.parse::<usize>().unwrap() > 20);
+    let runs = row[9].parse::<usize>().unwrap() + usize::from(dropped_later);
+    assert!(runs > 0, "{csv}");
+    assert!(
+        stderr(&o).contains(&format!("recorded {runs} Stage 1 starts")),
+        "{}",
+        stderr(&o)
+    );
+    let from = |file: &std::path::Path, stage: &str| {
+        dexcube(
+            &[
+                &[
+                    "eval-stage",
+                    stage,
+                    "--episodes",
+                    "1000",
+                    "--threads",
+                    "1",
+                    "--starts",
+                    file.to_str().unwrap(),
+                ][..],
+                &policies,
+            ]
+            .concat(),
+            "",
+        )
+    };
+    let o = from(&starts, "rot");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = stdout(&o);
+    assert!(
+        said.contains(&format!("/{runs} = ")) && said.contains("from the recorded starts in"),
+        "{said}"
+    );
+    assert!(said.contains("starts from which the recorded policy dropped the cube"));
+    assert_clean_failure(&from(&starts, "layer"), 2, "--starts are Stage 1's");
+    let policy = models().join("rot.safetensors");
+    assert_clean_failure(&from(&policy, "rot"), 2, "not a file of recorded starts");
+}
+
 #[test]
 fn render_writes_a_picture_and_missing_assets_fail_cleanly() {
     let out = std::env::temp_dir().join("dexcube-cli-render.png");
@@ -328,6 +410,16 @@ fn train_refuses_settings_it_cannot_run() {
         (&["rot", "--actor-lr", "0"], "--actor-lr must be a positive"),
         (&["rot", "--anchor=-1"], "--anchor must be 0 or more"),
         (&["rot", "--anchor", "10"], "pass --init or --init-actor"),
+        (&["layer", "--starts", "s"], "--starts are Stage 1's"),
+        (&["rot", "--start-share", "0.2"], "--starts <FILE>"),
+        (
+            &["rot", "--starts", "s", "--start-share", "2"],
+            "--start-share must be between 0 and 1",
+        ),
+        (
+            &["rot", "--object", "cube", "--starts", "/no/such/starts"],
+            "record starts with `dexcube eval",
+        ),
         (
             &[
                 "rot",

@@ -13,6 +13,7 @@
 //! On the physical cube either goal can gain one part, the cube's misalignment, for a success
 //! test that also needs the cube left in its good state ([`RotGoal::left_square`],
 //! [`LayerGoal::square`]).
+//! - [`RecordedStart`]: where the operator began Stage 1, for CubeRotEnv to reset from.
 //! - [`VecEnv`]: many environments stepped on a thread pool, each with its own `MjData`.
 //!
 //! Dynamics follow Gymnasium-Robotics' hand environments: an action in [-1, 1]^20 maps onto
@@ -24,6 +25,7 @@ mod hand_object;
 pub mod layer;
 pub mod random;
 pub mod rot;
+pub mod starts;
 pub mod vec_env;
 
 use std::sync::Arc;
@@ -36,6 +38,7 @@ pub use hand_object::{
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, achieved_goal, pose_goal};
+pub use starts::{RecordedStart, StartMix, StartPick};
 pub use vec_env::VecEnv;
 
 /// Control steps in an episode (the paper's 100).

@@ -28,6 +28,7 @@ use rand::Rng;
 use crate::goal::{Goal, RotGoal, RotMode};
 use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
 use crate::random::uniform_rotation;
+use crate::starts::{RecordedStart, StartMix, StartPick};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// The paper's three Stage 1 targets, `[w, x, y, z]`.
@@ -51,6 +52,7 @@ pub struct CubeRotEnv {
     hand: HandObject,
     goal: Arc<RotGoal>,
     desired: Vec<f64>,
+    starts: Option<StartMix>,
 }
 
 impl CubeRotEnv {
@@ -70,7 +72,33 @@ impl CubeRotEnv {
             hand,
             goal: Arc::new(goal),
             desired,
+            starts: None,
         }
+    }
+
+    /// The same environment resetting from recorded starts, as `mix.pick` says, rather than
+    /// from a fresh placement. The starts must come from this environment's scene; one that
+    /// does not fit falls back to a fresh placement.
+    pub fn with_starts(mut self, mix: StartMix) -> CubeRotEnv {
+        self.starts = Some(mix);
+        self
+    }
+
+    /// Starts an episode from a recorded start, with its goal pose; fails, leaving the
+    /// simulation as it was, if the start's physics state does not fit this scene.
+    pub fn reset_from(&mut self, start: &RecordedStart) -> Result<(Observation, Info), SimError> {
+        self.hand.sim.restore_physics_state(&start.state)?;
+        self.hand.steps = 0;
+        self.desired = start.pose_goal.clone();
+        self.show_target();
+        Ok(self.first_observation())
+    }
+
+    /// The episode's first observation and its info.
+    fn first_observation(&self) -> (Observation, Info) {
+        let observation = observe(&self.hand, &self.goal, &self.desired);
+        let info = self.hand.info(&observation, self.goal.as_ref(), None);
+        (observation, info)
     }
 
     /// The same environment judged by `goal`, e.g. [`RotGoal::left_square`] to also need the
@@ -158,13 +186,24 @@ impl GoalEnv for CubeRotEnv {
 
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
         self.hand.seed(seed);
+        if let Some(StartMix { starts, pick }) = self.starts.clone()
+            && !starts.is_empty()
+        {
+            let rng = &mut self.hand.rng;
+            let k = match (pick, seed) {
+                (StartPick::Numbered, Some(seed)) => Some(seed as usize % starts.len()),
+                (StartPick::Share(share), _) if rng.random::<f64>() >= share => None,
+                _ => Some(rng.random_range(0..starts.len())),
+            };
+            if let Some(Ok(first)) = k.map(|k| self.reset_from(&starts[k])) {
+                return first;
+            }
+        }
         self.hand.place(uniform_rotation);
         let pick = self.hand.rng.random_range(0..PAPER_TARGETS.len());
         self.desired = pose_goal(self.hand.resting, PAPER_TARGETS[pick]);
         self.show_target();
-        let observation = observe(&self.hand, &self.goal, &self.desired);
-        let info = self.hand.info(&observation, self.goal.as_ref(), None);
-        (observation, info)
+        self.first_observation()
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {

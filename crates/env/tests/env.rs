@@ -1,9 +1,10 @@
 //! The goal-env contract of CubeRotEnv and LayerOpEnv, with real physics.
 
 use dexcube_env::layer::LayerGoals;
+use dexcube_env::rot::PAPER_TARGETS;
 use dexcube_env::{
-    CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal,
-    RotMode, SimulatedEnv, VecEnv,
+    CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind,
+    RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, VecEnv, pose_goal,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
@@ -405,5 +406,54 @@ fn every_episode_on_the_physical_cube_starts_in_a_good_state() {
             misalignment < ALIGNED_TOLERANCE,
             "seed {seed}: the cube starts {misalignment:.3} rad off a quarter turn"
         );
+    }
+}
+
+/// CubeRotEnv resets from recorded starts: numbered, seed k begins from start k (modulo their
+/// number) and goes on exactly as the recorded simulation did; by share, never at 0 and
+/// always at 1.
+#[test]
+fn cube_rot_env_resets_from_recorded_starts() {
+    let scene = Scene::load(ObjectKind::Cube.scene()).unwrap();
+    let goal = RotGoal::paper(RotMode::Pair);
+    let mut source = CubeRotEnv::with_scene(scene.clone(), goal);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let starts: Vec<RecordedStart> = (0..2)
+        .map(|k| {
+            source.reset(Some(k));
+            for _ in 0..5 {
+                source.step(&random_action(&mut rng));
+            }
+            RecordedStart {
+                state: source.sim().physics_state(),
+                pose_goal: pose_goal(source.resting_point(), PAPER_TARGETS[k as usize + 1]),
+                dropped: false,
+            }
+        })
+        .collect();
+    let action = random_action(&mut rng);
+    let continued = source.step(&action).observation;
+    let env = |pick| {
+        let mix = StartMix {
+            starts: starts.clone().into(),
+            pick,
+        };
+        CubeRotEnv::with_scene(scene.clone(), goal).with_starts(mix)
+    };
+
+    let mut numbered = env(StartPick::Numbered);
+    let (first, _) = numbered.reset(Some(3));
+    assert_eq!(first.desired_goal, starts[1].pose_goal);
+    assert_eq!(numbered.sim().physics_state(), starts[1].state);
+    assert_eq!(numbered.step(&action).observation, continued);
+    numbered.reset(Some(0));
+    assert_eq!(numbered.sim().physics_state(), starts[0].state);
+
+    let (mut never, mut always) = (env(StartPick::Share(0.0)), env(StartPick::Share(1.0)));
+    let recorded = |env: &CubeRotEnv| starts.iter().any(|s| s.state == env.sim().physics_state());
+    for seed in 0..8 {
+        never.reset(Some(seed));
+        always.reset(Some(seed));
+        assert!(!recorded(&never) && recorded(&always), "seed {seed}");
     }
 }

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use burn::prelude::Device;
 use dexcube_cube::{DistanceTable, Move};
-use dexcube_env::{RotGoal, RotMode};
+use dexcube_env::{RecordedStart, RotGoal, RotMode};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_sim::{Scene, SceneKind, Sim};
@@ -15,7 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::operator::{Operator, OperatorConfig, StageRecord, set_up_scramble};
-use crate::stages::{Driving, PolicyStage1, PolicyStage2, pose_reached};
+use crate::stages::{Driving, PolicyStage1, PolicyStage2, RecordingStage1, Stage1, pose_reached};
 
 /// The paper's Table I, move distances 1 to 14.
 pub const PAPER_SR_ROLLBACK: [f64; 14] = [
@@ -149,10 +149,12 @@ impl CubeResult {
     }
 }
 
-/// Callbacks while a cube is solved: after every control step, and at every event.
+/// Callbacks while a cube is solved: after every control step, and at every event; and
+/// where to record Stage 1's starts, if anywhere ([`RecordingStage1`]).
 pub struct Hooks<'a> {
     pub watch: &'a mut dyn FnMut(&mut Sim),
     pub narrate: &'a mut dyn FnMut(&crate::Event),
+    pub stage1_starts: Option<&'a mut Vec<RecordedStart>>,
 }
 
 /// Solves one scrambled cube with the hand. The cube is made from `scramble` on the palm;
@@ -171,9 +173,20 @@ pub fn run_cube(
     let accepts = pose_reached(RotGoal::paper(stages.stage1.goal.mode));
     stages.stage1.driving = config.driving;
     stages.stage2.driving = config.driving;
+    let mut recording;
+    let stage1: &mut dyn Stage1 = match hooks.stage1_starts {
+        Some(starts) => {
+            recording = RecordingStage1 {
+                inner: &mut stages.stage1,
+                starts,
+            };
+            &mut recording
+        }
+        None => &mut stages.stage1,
+    };
     let mut operator = Operator {
         config,
-        stage1: &mut stages.stage1,
+        stage1,
         stage1_accepts: &accepts,
         stage2: &mut stages.stage2,
         table,

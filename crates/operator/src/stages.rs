@@ -9,8 +9,8 @@ use std::path::Path;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RotGoal, RotMode, SETTLE_STEPS, achieved_goal,
-    base_observation, is_dropped, pose_goal, set_down,
+    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RecordedStart, RotGoal, RotMode, SETTLE_STEPS,
+    achieved_goal, base_observation, is_dropped, pose_goal, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -79,6 +79,10 @@ impl Driving {
     };
 }
 
+/// Control steps that open the hand and let the cube settle before a stage's policy acts
+/// (see [`drive`]).
+pub const OPENING_STEPS: usize = 2 * SETTLE_STEPS;
+
 /// Runs a policy for its episode, as its training and `eval-stage` do: the policies learn to
 /// reach their goal by the episode's last step and hold it there. The stage is judged at its
 /// end, and `stop` may end it sooner: it is asked after every step. (Ending at the first step
@@ -118,7 +122,7 @@ fn drive(
     if !advance(
         sim,
         settling,
-        2 * SETTLE_STEPS,
+        OPENING_STEPS,
         resting_z,
         watch,
         never,
@@ -277,6 +281,37 @@ impl Stage2 for PolicyStage2 {
             &mut |_| false,
             watch,
         )
+    }
+}
+
+/// A Stage 1 that records where each of its runs hands over to the policy: the physics state
+/// once the hand has opened (after [`OPENING_STEPS`]), the pose asked for, and whether the
+/// run then dropped the cube. A run that dropped the cube while the hand opened records
+/// nothing.
+pub struct RecordingStage1<'a> {
+    pub inner: &'a mut dyn Stage1,
+    pub starts: &'a mut Vec<RecordedStart>,
+}
+
+impl Stage1 for RecordingStage1<'_> {
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
+        let (mut steps, mut state) = (0, None);
+        let mut recording = |sim: &mut Sim| {
+            watch(sim);
+            steps += 1;
+            if steps == OPENING_STEPS {
+                state = Some(sim.physics_state());
+            }
+        };
+        let run = self.inner.run(sim, position, target, &mut recording);
+        if let Some(state) = state {
+            self.starts.push(RecordedStart {
+                state,
+                pose_goal: pose_goal(position, target),
+                dropped: run.dropped,
+            });
+        }
+        run
     }
 }
 

@@ -4,10 +4,12 @@
 
 use dexcube_cube::Face;
 use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
-use dexcube_env::{RotGoal, RotMode};
+use dexcube_env::{
+    CubeRotEnv, EPISODE_STEPS, GoalEnv, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick,
+};
 use dexcube_operator::stages::{
-    Driving, KinematicStage1, KinematicStage2, Stage1, Stage2, StageRun, Watch, pose_reached,
-    randomise_pose,
+    Driving, KinematicStage1, KinematicStage2, OPENING_STEPS, RecordingStage1, Stage1, Stage2,
+    StageRun, Watch, pose_reached, randomise_pose,
 };
 use dexcube_operator::{
     Failure, Operator, OperatorConfig, Outcome, hand_cost, move_plan, set_up_scramble,
@@ -363,7 +365,7 @@ fn a_held_pose_ends_policy_stage_1_early() {
     let (mut stages, resting) = shipped_stages();
     let target = dexcube_operator::stages::stage1_target(Face::U);
     let accepts = pose_reached(RotGoal::paper(RotMode::Pair));
-    let settle = 2 * dexcube_env::SETTLE_STEPS;
+    let settle = OPENING_STEPS;
     let mut steps = Vec::new();
     for held in [None, Some(3)] {
         let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
@@ -508,4 +510,43 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
         });
         assert_eq!(retried, stage1_good_state, "{events:?}");
     }
+}
+
+/// A recorded Stage 1 start is where the policy took over, once the hand had opened: a
+/// CubeRotEnv reset from it and run with the same policy for an episode ends exactly where
+/// the operator's Stage 1 did. This is what lets `eval-stage` and training start where the
+/// operator hands the cube over.
+#[test]
+fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
+    let (mut stages, resting) = shipped_stages();
+    let scene = Scene::load(SceneKind::Cube).unwrap();
+    let mut sim = Sim::new(scene.clone());
+    set_up_scramble(&mut sim, &[], resting);
+    sim.set_action(&[0.3; dexcube_sim::HAND_ACTUATORS]);
+    let target = dexcube_operator::stages::stage1_target(Face::R);
+    let mut starts = Vec::new();
+    let run = RecordingStage1 {
+        inner: &mut stages.stage1,
+        starts: &mut starts,
+    }
+    .run(&mut sim, resting, target, &mut |_| {});
+    assert_eq!(starts.len(), 1, "one run, one start");
+    assert_eq!(starts[0].dropped, run.dropped);
+    assert_eq!(run.steps, OPENING_STEPS + EPISODE_STEPS);
+
+    let mix = StartMix {
+        starts: starts.into(),
+        pick: StartPick::Numbered,
+    };
+    let mut env = CubeRotEnv::with_scene(scene, stages.stage1.goal).with_starts(mix);
+    let (mut obs, _) = env.reset(Some(0));
+    for _ in 0..EPISODE_STEPS {
+        let action = stages
+            .stage1
+            .policy
+            .act(&obs.observation, &obs.desired_goal);
+        obs = env.step(&action).observation;
+    }
+    assert_eq!(env.sim().object_pose(), sim.object_pose());
+    assert_eq!(env.sim().hand_angles(), sim.hand_angles());
 }

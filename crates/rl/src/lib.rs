@@ -9,6 +9,7 @@
 //! - [`replay`]: the HER buffer, relabelling goals at sampling time;
 //! - [`rollout`]: episodes from a `VecEnv`;
 //! - [`train`]: the epoch / cycle / batch schedule with checkpoints, curves and resume;
+//! - [`start_file`]: recorded Stage 1 starts on disk, to train and evaluate from;
 //! - [`seeds`]: learning curves across seeds, mean ± one standard deviation;
 //! - [`policy`]: a trained actor as shipped, with its normalisers;
 //! - [`point_mass`]: a small reaching task that proves the learner in seconds.
@@ -28,6 +29,7 @@ pub mod policy;
 pub mod replay;
 pub mod rollout;
 pub mod seeds;
+pub mod start_file;
 pub mod train;
 
 pub use agent::{Agent, Dims, Learners, SavedAnchor};

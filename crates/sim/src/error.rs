@@ -22,6 +22,8 @@ pub enum SimError {
     },
     /// The simulation produced NaN or infinite values, or MuJoCo flagged an unstable state.
     Diverged { time: f64, what: String },
+    /// A recorded physics state does not fit the scene it is restored into.
+    BadState { message: String },
     /// Offscreen rendering could not start or run.
     Render { message: String },
     /// A picture or video could not be written.
@@ -57,6 +59,11 @@ impl fmt::Display for SimError {
             SimError::Diverged { time, what } => write!(
                 f,
                 "the simulation diverged at t = {time:.3} s ({what}); reset the environment"
+            ),
+            SimError::BadState { message } => write!(
+                f,
+                "a recorded physics state does not fit this scene ({message}): it was recorded on \
+                 another scene or with another MuJoCo; record it again"
             ),
             SimError::Render { message } => write!(
                 f,

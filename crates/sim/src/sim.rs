@@ -30,6 +30,20 @@ const BAD_STATE_WARNINGS: [(mjtWarning, &str); 3] = [
     ),
 ];
 
+/// What a recorded physics state holds: MuJoCo's integration state (time, joint positions
+/// and velocities, activations, the solver's warm start, controls, mocap poses, equality
+/// switches) less the applied forces, which the cube's detent sets afresh before every
+/// substep. Restoring it continues the simulation exactly as it would have gone on.
+const PHYSICS_STATE: u32 = MjtState::mjSTATE_TIME as u32
+    | MjtState::mjSTATE_QPOS as u32
+    | MjtState::mjSTATE_QVEL as u32
+    | MjtState::mjSTATE_ACT as u32
+    | MjtState::mjSTATE_WARMSTART as u32
+    | MjtState::mjSTATE_CTRL as u32
+    | MjtState::mjSTATE_EQ_ACTIVE as u32
+    | MjtState::mjSTATE_MOCAP_POS as u32
+    | MjtState::mjSTATE_MOCAP_QUAT as u32;
+
 /// A position and orientation in the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pose {
@@ -130,6 +144,38 @@ impl Sim {
         let checked = self.check_finite(before);
         self.physics_time += start.elapsed();
         checked
+    }
+
+    /// The physics state, to restore later into this scene's simulations
+    /// ([`Sim::restore_physics_state`]): e.g. where an operator's stage began.
+    pub fn physics_state(&self) -> Vec<f64> {
+        self.data.state(PHYSICS_STATE).into_vec()
+    }
+
+    /// How many numbers this scene's physics state has.
+    pub fn physics_state_size(&self) -> usize {
+        self.scene.model().state_size(PHYSICS_STATE)
+    }
+
+    /// Puts the simulation back in a state taken by [`Sim::physics_state`] from this scene;
+    /// fails, leaving it as it was, if the state has the wrong size for it.
+    pub fn restore_physics_state(&mut self, state: &[f64]) -> Result<(), SimError> {
+        let expected = self.physics_state_size();
+        if state.len() != expected {
+            return Err(SimError::BadState {
+                message: format!(
+                    "{} numbers, where this scene's state has {expected}",
+                    state.len()
+                ),
+            });
+        }
+        self.data
+            .set_state(state, PHYSICS_STATE)
+            .map_err(|e| SimError::BadState {
+                message: e.to_string(),
+            })?;
+        self.data.forward();
+        Ok(())
     }
 
     /// Recomputes positions, contacts and the rest after the state was set by hand.

@@ -247,3 +247,44 @@ fn the_open_hand_action_flattens_a_clenched_hand() {
     );
     assert!(far(&open) < 0.5, "open: {open:?}");
 }
+
+/// A physics state taken mid-motion and restored into a fresh simulation of the scene goes
+/// on exactly as the original did: what lets an episode start where an operator's stage did.
+#[test]
+fn a_restored_physics_state_continues_exactly() {
+    let scene = Scene::load(SceneKind::Cube).expect("run scripts/setup first");
+    let mut original = Sim::new(scene.clone());
+    let action = |k: usize| {
+        std::array::from_fn::<f64, { dexcube_sim::HAND_ACTUATORS }, _>(|j| {
+            ((k * 7 + j * 3) as f64 * 0.37).sin()
+        })
+    };
+    let run = |sim: &mut Sim, from: usize, to: usize| {
+        for k in from..to {
+            sim.set_action(&action(k));
+            sim.step().expect("stable");
+        }
+    };
+    run(&mut original, 0, 10);
+    let saved = original.physics_state();
+    assert_eq!(saved.len(), original.physics_state_size());
+    run(&mut original, 10, 25);
+
+    let mut restored = Sim::new(scene);
+    assert_ne!(restored.physics_state(), saved);
+    restored.restore_physics_state(&saved).expect("same scene");
+    assert_eq!(restored.physics_state(), saved);
+    run(&mut restored, 10, 25);
+    assert_eq!(restored.physics_state(), original.physics_state());
+    assert_eq!(restored.object_pose(), original.object_pose());
+
+    let before = restored.physics_state();
+    let error = restored
+        .restore_physics_state(&saved[1..])
+        .expect_err("a state one number short");
+    assert!(
+        error.to_string().contains("does not fit this scene"),
+        "{error}"
+    );
+    assert_eq!(restored.physics_state(), before, "left as it was");
+}
