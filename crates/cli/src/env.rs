@@ -279,6 +279,9 @@ pub fn starts_for(
     scene: &std::sync::Arc<Scene>,
 ) -> anyhow::Result<std::sync::Arc<[dexcube_env::RecordedStart]>> {
     let (starts, origin) = dexcube_rl::start_file::load_starts(path)?;
+    if starts.is_empty() {
+        bail!("{} holds no starts", path.display());
+    }
     let name = scene.kind().name();
     if origin.scene != name {
         bail!(
@@ -297,9 +300,6 @@ pub fn starts_for(
             start.state.len(),
             origin.command
         );
-    }
-    if starts.is_empty() {
-        bail!("{} holds no starts", path.display());
     }
     Ok(starts.into())
 }

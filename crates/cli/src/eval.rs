@@ -407,6 +407,13 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         let mut recorded = recorded.into_inner().expect("lock");
         recorded.sort_by_key(|(k, _)| *k);
         let starts: Vec<_> = recorded.into_iter().flat_map(|(_, s)| s).collect();
+        if starts.is_empty() {
+            bail!(
+                "no Stage 1 run began with the hand open in these cubes, so {} was not written: \
+                 record over more cubes or longer move distances",
+                path.display()
+            );
+        }
         let origin = StartsOrigin {
             scene: SceneKind::Cube.name().to_string(),
             command: format!("{} --record-starts {}", command(&results), path.display()),

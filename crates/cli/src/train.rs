@@ -88,7 +88,7 @@ pub struct TrainArgs {
     no_her: bool,
     /// rot on the physical cube: begin a share of episodes (--start-share) from the Stage 1
     /// starts recorded in this file (`dexcube eval --record-starts`), where the operator hands
-    /// the cube over, rather than from a fresh placement. Give it again to resume.
+    /// the cube over, rather than from a fresh placement. A resume must name the same.
     #[arg(long, value_name = "FILE")]
     starts: Option<PathBuf>,
     /// With --starts, the probability that an episode begins from one of them.
@@ -133,6 +133,39 @@ pub fn plot(args: PlotArgs) -> anyhow::Result<ExitCode> {
     };
     println!("{}", path.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses to resume a run with other recorded starts than it began with (its checkpoint's
+/// card names them), since the card would then say it trained on starts it did not.
+fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {
+    let path = run.join("checkpoint/state.json");
+    // A missing or unreadable checkpoint is the trainer's to report.
+    let Some(state) = std::fs::read_to_string(&path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+    else {
+        return Ok(());
+    };
+    let environment = &state["start"]["environment"];
+    let flags = |starts: Option<String>, share: Option<f64>| match (starts, share) {
+        (Some(starts), Some(share)) => format!("--starts {starts} --start-share {share}"),
+        _ => "no --starts".to_string(),
+    };
+    let begun = flags(
+        environment["starts"].as_str().map(str::to_string),
+        environment["start_share"].as_f64(),
+    );
+    let now = flags(
+        args.starts.as_ref().map(|p| p.display().to_string()),
+        Some(args.start_share),
+    );
+    if begun != now {
+        bail!(
+            "{} began with {begun}; resume it with the same, not {now}",
+            run.display()
+        );
+    }
+    Ok(())
 }
 
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
@@ -180,6 +213,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             false,
         ),
     };
+    if resume {
+        same_starts_as_begun(&out, &args)?;
+    }
     let published = DdpgHerConfig::default();
     let config = DdpgHerConfig {
         batches_per_cycle: args.batches,

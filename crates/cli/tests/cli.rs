@@ -439,6 +439,41 @@ fn train_refuses_settings_it_cannot_run() {
     }
 }
 
+/// A run resumes only with the recorded starts it began with (here: none), so that its card
+/// never names starts it did not train on.
+#[test]
+fn train_resumes_only_with_the_starts_it_began_with() {
+    let run = std::env::temp_dir().join("dexcube-cli-resume-starts");
+    let _ = std::fs::remove_dir_all(&run);
+    std::fs::create_dir_all(run.join("checkpoint")).unwrap();
+    let committed = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../results/training/rot-pair-cube-square-anchor5-seed0/checkpoint/state.json"
+    );
+    std::fs::copy(committed, run.join("checkpoint/state.json")).unwrap();
+    let o = dexcube(
+        &[
+            "train",
+            "rot",
+            "--mode",
+            "pair",
+            "--object",
+            "cube",
+            "--square",
+            "--resume",
+            run.to_str().unwrap(),
+            "--starts",
+            "s.safetensors",
+        ],
+        "",
+    );
+    assert_clean_failure(
+        &o,
+        2,
+        "began with no --starts; resume it with the same, not --starts s.safetensors",
+    );
+}
+
 /// `eval-stage --record` writes the figure on the policy's own object as its evaluation, and
 /// one on another object beside it; an object the stage cannot hold is refused.
 #[test]

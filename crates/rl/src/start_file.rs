@@ -111,7 +111,7 @@ pub fn load_starts(path: &Path) -> Result<(Vec<RecordedStart>, StartsOrigin), Ch
     let [n, size] = state_shape[..] else {
         return Err(corrupt(format!("'state' has shape {state_shape:?}")));
     };
-    if goal_shape != [n, POSE_GOAL] || dropped_shape != [n] || size == 0 {
+    if goal_shape != [n, POSE_GOAL] || dropped_shape != [n] || (size == 0 && n > 0) {
         return Err(corrupt(format!(
             "shapes {state_shape:?}, {goal_shape:?} and {dropped_shape:?} do not agree"
         )));
