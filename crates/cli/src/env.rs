@@ -291,7 +291,7 @@ pub fn starts_for(
             origin.scene
         );
     }
-    let size = dexcube_sim::Sim::new(scene.clone()).physics_state_size();
+    let size = scene.physics_state_size();
     if let Some(start) = starts.iter().find(|s| s.state.len() != size) {
         bail!(
             "{} holds physics states of {} numbers where this scene's have {size}: it was \

@@ -138,19 +138,15 @@ pub fn plot(args: PlotArgs) -> anyhow::Result<ExitCode> {
 /// Refuses to resume a run with other recorded starts than it began with (its checkpoint's
 /// card names them), since the card would then say it trained on starts it did not.
 fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {
-    let path = run.join("checkpoint/state.json");
     // A missing or unreadable checkpoint is the trainer's to report.
-    let Some(state) = std::fs::read_to_string(&path)
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-    else {
+    let Ok(begun) = dexcube_rl::train::RunCurve::read(run) else {
         return Ok(());
     };
-    let environment = &state["start"]["environment"];
     let flags = |starts: Option<String>, share: Option<f64>| match (starts, share) {
         (Some(starts), Some(share)) => format!("--starts {starts} --start-share {share}"),
         _ => "no --starts".to_string(),
     };
+    let environment = &begun.environment;
     let begun = flags(
         environment["starts"].as_str().map(str::to_string),
         environment["start_share"].as_f64(),

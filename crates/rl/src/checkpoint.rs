@@ -56,30 +56,42 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), CheckpointError
 
 /// Saves tensors as a safetensors file.
 pub fn save_tensors(path: &Path, tensors: &[NamedTensor]) -> Result<(), CheckpointError> {
-    let bytes: Vec<(String, Vec<u8>, Vec<usize>)> = tensors
+    let raw: Vec<RawTensor> = tensors
         .iter()
-        .map(|t| {
-            (
-                t.name.clone(),
-                t.values.iter().flat_map(|v| v.to_le_bytes()).collect(),
-                t.shape.clone(),
-            )
+        .map(|t| RawTensor {
+            name: t.name.clone(),
+            dtype: Dtype::F32,
+            shape: t.shape.clone(),
+            data: t.values.iter().flat_map(|v| v.to_le_bytes()).collect(),
         })
         .collect();
-    let views = bytes
-        .iter()
-        .map(|(name, data, shape)| {
-            TensorView::new(Dtype::F32, shape.clone(), data).map(|v| (name.clone(), v))
-        })
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| CheckpointError::Io {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-    let serialized = safetensors::serialize(views, None).map_err(|e| CheckpointError::Io {
+    write_safetensors(path, &raw, None)
+}
+
+/// A tensor's little-endian bytes, as a safetensors file holds them.
+pub struct RawTensor {
+    pub name: String,
+    pub dtype: Dtype,
+    pub shape: Vec<usize>,
+    pub data: Vec<u8>,
+}
+
+/// Writes tensors, with optional text metadata, as a safetensors file (atomically).
+pub fn write_safetensors(
+    path: &Path,
+    tensors: &[RawTensor],
+    metadata: Option<std::collections::HashMap<String, String>>,
+) -> Result<(), CheckpointError> {
+    let io = |message: String| CheckpointError::Io {
         path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
+        message,
+    };
+    let views = tensors
+        .iter()
+        .map(|t| TensorView::new(t.dtype, t.shape.clone(), &t.data).map(|v| (t.name.clone(), v)))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| io(e.to_string()))?;
+    let serialized = safetensors::serialize(views, metadata).map_err(|e| io(e.to_string()))?;
     write_atomically(path, &serialized)
 }
 

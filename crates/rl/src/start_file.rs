@@ -7,9 +7,9 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use dexcube_env::RecordedStart;
-use safetensors::tensor::{Dtype, TensorView};
+use safetensors::tensor::Dtype;
 
-use crate::checkpoint::{CheckpointError, write_atomically};
+use crate::checkpoint::{CheckpointError, RawTensor, write_safetensors};
 
 /// What a file of starts says about where they came from.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,51 +28,48 @@ pub fn save_starts(
     starts: &[RecordedStart],
     origin: &StartsOrigin,
 ) -> Result<(), CheckpointError> {
-    let io = |message: String| CheckpointError::Io {
-        path: path.to_path_buf(),
-        message,
-    };
     let size = starts.first().map_or(0, |s| s.state.len());
     if starts
         .iter()
         .any(|s| s.state.len() != size || s.pose_goal.len() != POSE_GOAL)
     {
-        return Err(io("the starts differ in size".into()));
+        return Err(CheckpointError::Io {
+            path: path.to_path_buf(),
+            message: "the starts differ in size".into(),
+        });
     }
-    let bytes = |values: &mut dyn Iterator<Item = f64>| -> Vec<u8> {
-        values.flat_map(f64::to_le_bytes).collect()
+    let n = starts.len();
+    let tensor = |name: &str, shape: Vec<usize>, values: Vec<f64>| RawTensor {
+        name: name.to_string(),
+        dtype: Dtype::F64,
+        shape,
+        data: values.into_iter().flat_map(f64::to_le_bytes).collect(),
     };
     let tensors = [
-        (
+        tensor(
             "state",
-            bytes(&mut starts.iter().flat_map(|s| s.state.iter().copied())),
-            vec![starts.len(), size],
+            vec![n, size],
+            starts.iter().flat_map(|s| s.state.clone()).collect(),
         ),
-        (
+        tensor(
             "pose_goal",
-            bytes(&mut starts.iter().flat_map(|s| s.pose_goal.iter().copied())),
-            vec![starts.len(), POSE_GOAL],
+            vec![n, POSE_GOAL],
+            starts.iter().flat_map(|s| s.pose_goal.clone()).collect(),
         ),
-        (
+        tensor(
             "dropped",
-            bytes(&mut starts.iter().map(|s| f64::from(u8::from(s.dropped)))),
-            vec![starts.len()],
+            vec![n],
+            starts
+                .iter()
+                .map(|s| f64::from(u8::from(s.dropped)))
+                .collect(),
         ),
     ];
-    let views = tensors
-        .iter()
-        .map(|(name, data, shape)| {
-            TensorView::new(Dtype::F64, shape.clone(), data).map(|v| (name.to_string(), v))
-        })
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| io(e.to_string()))?;
     let metadata = HashMap::from([
         ("scene".to_string(), origin.scene.clone()),
         ("command".to_string(), origin.command.clone()),
     ]);
-    let serialized =
-        safetensors::serialize(views, Some(metadata)).map_err(|e| io(e.to_string()))?;
-    write_atomically(path, &serialized)
+    write_safetensors(path, &tensors, Some(metadata))
 }
 
 /// Reads a file written by [`save_starts`], checking its tensors' names, types and shapes.

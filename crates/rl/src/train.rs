@@ -506,12 +506,15 @@ pub fn replot(dir: &Path) -> Result<PathBuf, TrainError> {
     plot_learning_curve(dir, &run.label, run.seed, &run.metrics).map_err(TrainError::Plot)
 }
 
-/// A training run's learning curve, as its checkpoint keeps it.
+/// A training run's learning curve, as its checkpoint keeps it, with what the run was: its
+/// label, seed, hyperparameters and the environment facts its first call named.
 pub struct RunCurve {
     pub label: String,
     pub seed: u64,
     pub config: DdpgHerConfig,
     pub metrics: Vec<EpochMetrics>,
+    /// The environment facts of the policy cards (`null` for checkpoints older than them).
+    pub environment: serde_json::Value,
 }
 
 impl RunCurve {
@@ -530,6 +533,9 @@ impl RunCurve {
             seed: state.seed,
             config: state.config,
             metrics: state.metrics,
+            environment: state
+                .start
+                .map_or(serde_json::Value::Null, |s| s.environment),
         })
     }
 }

@@ -198,6 +198,11 @@ impl Scene {
         &self.model
     }
 
+    /// How many numbers a physics state of this scene has ([`crate::Sim::physics_state`]).
+    pub fn physics_state_size(&self) -> usize {
+        self.model.state_size(crate::sim::PHYSICS_STATE)
+    }
+
     /// The hand's 24 joints, wrist first, in Gymnasium-Robotics' order.
     pub fn hand_joints(&self) -> &[JointAddress; HAND_JOINTS] {
         &self.hand_joints

@@ -34,7 +34,7 @@ const BAD_STATE_WARNINGS: [(mjtWarning, &str); 3] = [
 /// and velocities, activations, the solver's warm start, controls, mocap poses, equality
 /// switches) less the applied forces, which the cube's detent sets afresh before every
 /// substep. Restoring it continues the simulation exactly as it would have gone on.
-const PHYSICS_STATE: u32 = MjtState::mjSTATE_TIME as u32
+pub(crate) const PHYSICS_STATE: u32 = MjtState::mjSTATE_TIME as u32
     | MjtState::mjSTATE_QPOS as u32
     | MjtState::mjSTATE_QVEL as u32
     | MjtState::mjSTATE_ACT as u32
@@ -152,15 +152,10 @@ impl Sim {
         self.data.state(PHYSICS_STATE).into_vec()
     }
 
-    /// How many numbers this scene's physics state has.
-    pub fn physics_state_size(&self) -> usize {
-        self.scene.model().state_size(PHYSICS_STATE)
-    }
-
     /// Puts the simulation back in a state taken by [`Sim::physics_state`] from this scene;
     /// fails, leaving it as it was, if the state has the wrong size for it.
     pub fn restore_physics_state(&mut self, state: &[f64]) -> Result<(), SimError> {
-        let expected = self.physics_state_size();
+        let expected = self.scene.physics_state_size();
         if state.len() != expected {
             return Err(SimError::BadState {
                 message: format!(

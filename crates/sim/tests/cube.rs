@@ -267,7 +267,7 @@ fn a_restored_physics_state_continues_exactly() {
     };
     run(&mut original, 0, 10);
     let saved = original.physics_state();
-    assert_eq!(saved.len(), original.physics_state_size());
+    assert_eq!(saved.len(), original.scene().physics_state_size());
     run(&mut original, 10, 25);
 
     let mut restored = Sim::new(scene);
