@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use clap::Args;
 use dexcube_cube::{DistanceTable, format_moves, scrambles_at_distance};
 use dexcube_operator::eval::{Hooks, resting_point, run_cube};
-use dexcube_operator::{Event, Failure};
+use dexcube_operator::{Event, Failure, Planner};
 use dexcube_sim::render::{DEFAULT_CAMERA, Frame, FrameRenderer, save_video};
 use dexcube_sim::{Scene, SceneKind, Sim};
 
@@ -80,11 +80,13 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
             }
         }
     };
+    let distance = args.distance;
     let mut narrate = |event: &Event| {
         let line = match event {
             Event::Plan(plan) => format!(
-                "Optimal plan, {} quarter turns: {}",
+                "Plan, {} quarter turns (optimal: {}): {}",
                 plan.len(),
+                distance,
                 format_moves(plan)
             ),
             Event::Stage1 {
@@ -129,7 +131,12 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         args.operator.config(!args.no_rollback),
         args.seed,
     );
-    let outcome = run_cube(&mut stages, &scene, &table, job, hooks);
+    let hand_plans = args.operator.hand_plans();
+    let planner = Planner {
+        optimal: &table,
+        any_length: hand_plans.as_ref(),
+    };
+    let outcome = run_cube(&mut stages, &scene, planner, job, hooks);
     let mut out = io::stdout().lock();
     match outcome.failure {
         None => writeln!(out, "Solved with {} atomic actions.", outcome.actions)?,

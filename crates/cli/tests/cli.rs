@@ -140,7 +140,7 @@ fn demo_narrates_the_hand_solving_with_the_shipped_policies() {
         "",
     );
     let out = stdout(&o);
-    assert!(out.contains("Optimal plan, 1 quarter turns"), "{out}");
+    assert!(out.contains("Plan, 1 quarter turns (optimal: 1)"), "{out}");
     // Stage 1 either brings the face up or, when it already is, says it is not needed.
     assert!(
         out.contains("Stage 1: ") && out.contains("Stage 2: U' on the top layer"),
@@ -212,6 +212,7 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
         &["--stage1-held", "0"],
         &["--opening", "at-once"],
         &["--plan-from-face-up"],
+        &["--stage1-price", "5"],
     ] {
         let refused = dexcube(&[&args[..], other].concat(), "");
         assert_clean_failure(&refused, 2, "or another operator");

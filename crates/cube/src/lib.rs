@@ -19,10 +19,13 @@
 //!
 //! Two solvers give optimal answers of the same length: [`DistanceTable`] (an exact table of
 //! all 3,674,160 positions, built in about a tenth of a second) and [`IdaStar`] (the paper's
-//! IDA* with a pattern-database heuristic, no big table).
+//! IDA* with a pattern-database heuristic, no big table). For a solver that prices its moves,
+//! as a hand does, [`DistanceTable::cheapest_optimal`] takes the cheapest optimal solution and
+//! [`CostTable`] the cheapest of any length.
 
 pub mod batch;
 pub mod coord;
+pub mod costs;
 pub mod cubie;
 pub mod facelet;
 pub mod ida;
@@ -30,6 +33,7 @@ pub mod notation;
 pub mod scramble;
 pub mod table;
 
+pub use costs::CostTable;
 pub use cubie::{POSITIONS, Position};
 pub use facelet::{FaceletError, Facelets};
 pub use ida::IdaStar;

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use burn::prelude::Device;
-use dexcube_cube::{DistanceTable, Move};
+use dexcube_cube::Move;
 use dexcube_env::{RecordedStart, RotGoal, RotMode};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -14,7 +14,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::operator::{Operator, OperatorConfig, StageRecord, set_up_scramble};
+use crate::operator::{Operator, OperatorConfig, Planner, StageRecord, set_up_scramble};
 use crate::stages::{Driving, PolicyStage1, PolicyStage2, RecordingStage1, Stage1, pose_reached};
 
 /// The paper's Table I, move distances 1 to 14.
@@ -162,7 +162,7 @@ pub struct Hooks<'a> {
 pub fn run_cube(
     stages: &mut LoadedStages,
     scene: &std::sync::Arc<Scene>,
-    table: &DistanceTable,
+    planner: Planner,
     (scramble, config, seed): (&[Move], OperatorConfig, u64),
     hooks: Hooks,
 ) -> crate::Outcome {
@@ -189,7 +189,7 @@ pub fn run_cube(
         stage1,
         stage1_accepts: &accepts,
         stage2: &mut stages.stage2,
-        table,
+        planner,
         resting,
         rng: ChaCha8Rng::seed_from_u64(seed),
         watch: hooks.watch,

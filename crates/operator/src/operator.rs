@@ -17,10 +17,12 @@
 //!
 //! By default the operator plans for the hand: of the optimal plans it takes the one with the
 //! fewest atomic actions (`hand_cost`: U' is one Stage 2 run, U three), and it skips Stage 1
-//! when the face to turn is already up. `OperatorConfig::plan_for_hand` off gives the paper's
-//! operator: the first optimal plan, and Stage 1 before every move.
+//! when the face to turn is already up. Given a cost table ([`Planner::any_length`]) it takes
+//! the cheapest plan of any length instead, with a Stage 1 priced above a turn
+//! ([`hand_price`]). `OperatorConfig::plan_for_hand` off gives the paper's operator: the first
+//! optimal plan, and Stage 1 before every move.
 
-use dexcube_cube::{DistanceTable, Face, Facelets, Move, Position, Solver};
+use dexcube_cube::{CostTable, DistanceTable, Face, Facelets, Move, Position, Solver};
 use dexcube_env::is_square;
 use dexcube_sim::cube::{CubeState, snap_layers};
 use dexcube_sim::{Pose, Sim};
@@ -194,11 +196,33 @@ pub fn move_plan(m: Move) -> (Face, usize) {
 /// three Stage 2 turns, and a Stage 1 unless the face the move needs is up already: after a
 /// move that needed the same face up, or, for a plan's first move, when `up_now` is that face.
 pub fn hand_cost(up_now: Option<Face>) -> impl Fn(Option<Move>, Move) -> u32 {
+    let price = hand_price(1);
     move |before, m| {
-        let (up, turns) = move_plan(m);
         let up_before = before.map_or(up_now, |b| Some(move_plan(b).0));
-        (turns + usize::from(up_before != Some(up))) as u32
+        price(up_before.map(Face::axis), m)
     }
+}
+
+/// What a move costs the hand when a Stage 1 is priced at `stage1` U' turns, as a price for
+/// a [`CostTable`]: its one or three turns, and a Stage 1 unless the last move turned about
+/// the same axis (`None`: the axis up is not known, or no face is up). At 1 it counts atomic
+/// actions; above 1 it weighs the risk: a Stage 1 drops the cube far more often than a turn.
+pub fn hand_price(stage1: u32) -> impl Fn(Option<usize>, Move) -> u32 + Copy {
+    move |axis_before, m| {
+        let (up, turns) = move_plan(m);
+        turns as u32 + stage1 * u32::from(axis_before != Some(up.axis()))
+    }
+}
+
+/// Where the operator's plans come from.
+#[derive(Clone, Copy)]
+pub struct Planner<'a> {
+    /// Optimal plans: the paper's planner's first, or, planning for the hand, the one of
+    /// fewest atomic actions.
+    pub optimal: &'a DistanceTable,
+    /// Planning for the hand, the cheapest plan of any length instead, at the prices this
+    /// table was built with (see [`hand_price`]).
+    pub any_length: Option<&'a CostTable>,
 }
 
 /// The rollback's test of the cube's pose after Stage 1: (simulation, target position, target
@@ -210,7 +234,7 @@ pub struct Operator<'a> {
     pub stage1: &'a mut dyn Stage1,
     pub stage1_accepts: &'a PoseCheck,
     pub stage2: &'a mut dyn Stage2,
-    pub table: &'a DistanceTable,
+    pub planner: Planner<'a>,
     pub resting: [f64; 3],
     pub rng: ChaCha8Rng,
     /// Called after every control step, e.g. to record a video.
@@ -274,11 +298,12 @@ impl Operator<'_> {
         outcome
     }
 
-    /// An optimal plan from `cube`: the hand's cheapest, or the solver's first.
+    /// A plan from `cube`: the hand's cheapest, of any length or of the optimal ones, or the
+    /// solver's first optimal plan.
     fn plan(&self, sim: &Sim, cube: &Facelets) -> Vec<Move> {
         let position = Position::of(cube);
         if !self.config.plan_for_hand {
-            return self.table.solve(&position);
+            return self.planner.optimal.solve(&position);
         }
         let up_now = if self.config.plan_from_face_up {
             STAGE1_FACES
@@ -287,7 +312,13 @@ impl Operator<'_> {
         } else {
             None
         };
-        self.table.cheapest_optimal(&position, hand_cost(up_now))
+        match self.planner.any_length {
+            Some(costs) => costs.cheapest(&position, up_now.map(Face::axis)),
+            None => self
+                .planner
+                .optimal
+                .cheapest_optimal(&position, hand_cost(up_now)),
+        }
     }
 
     /// Whether the cube in `sim` already has `up` up, by the test that skips Stage 1.

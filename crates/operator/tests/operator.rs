@@ -3,7 +3,7 @@
 //! branch fires on the situation it is for.
 
 use dexcube_cube::Face;
-use dexcube_cube::{DistanceTable, Solver, scrambles_at_distance};
+use dexcube_cube::{CostTable, DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::{
     CubeRotEnv, EPISODE_STEPS, GoalEnv, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick,
 };
@@ -12,7 +12,8 @@ use dexcube_operator::stages::{
     StageRun, Watch, pose_reached, randomise_pose,
 };
 use dexcube_operator::{
-    Failure, Operator, OperatorConfig, Outcome, hand_cost, move_plan, set_up_scramble,
+    Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price, move_plan,
+    set_up_scramble,
 };
 use dexcube_sim::cube::{CubeState, snap_layers};
 use dexcube_sim::rotation::Quat;
@@ -34,13 +35,19 @@ fn attempt(
         rollback,
         ..OperatorConfig::default()
     };
-    attempt_judged(RotMode::Axis, config, stage1, stage2, distance, seed)
+    attempt_judged(
+        (RotMode::Axis, config, None),
+        stage1,
+        stage2,
+        distance,
+        seed,
+    )
 }
 
-/// `attempt`, with Stage 1's pose judged in `mode` and the operator configured by `config`.
+/// `attempt`, with Stage 1's pose judged in `mode`, the operator configured by `config`, and
+/// plans of any length from `any_length` if given.
 fn attempt_judged(
-    mode: RotMode,
-    config: OperatorConfig,
+    judged: Judged,
     stage1: &mut dyn Stage1,
     stage2: &mut dyn Stage2,
     distance: usize,
@@ -48,7 +55,6 @@ fn attempt_judged(
 ) -> Outcome {
     let table = DistanceTable::build();
     let scramble = scrambles_at_distance(&table, distance, 1, seed).remove(0);
-    let judged = (mode, config);
     solve_from(
         &scramble.moves,
         RESTING,
@@ -59,12 +65,16 @@ fn attempt_judged(
     )
 }
 
+/// How Stage 1's pose is judged, how the operator is configured, and the cost table of its
+/// plans of any length, if it plans so.
+type Judged<'a> = (RotMode, OperatorConfig, Option<&'a CostTable>);
+
 /// Solves `scramble`, made kinematically on the palm at `at`, with the given stages, Stage 1
 /// judged in `mode`, the operator configured by `config` and randomising from `seed`.
 fn solve_from(
     scramble: &[dexcube_cube::Move],
     at: [f64; 3],
-    (mode, config): (RotMode, OperatorConfig),
+    (mode, config, any_length): Judged,
     (stage1, stage2): (&mut dyn Stage1, &mut dyn Stage2),
     seed: u64,
     narrate: &mut dyn FnMut(&dexcube_operator::Event),
@@ -78,7 +88,10 @@ fn solve_from(
         stage1,
         stage1_accepts: &accepts,
         stage2,
-        table: &table,
+        planner: Planner {
+            optimal: &table,
+            any_length,
+        },
         resting: RESTING,
         rng: ChaCha8Rng::seed_from_u64(seed),
         watch: &mut |_| {},
@@ -109,8 +122,7 @@ fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
                 ..OperatorConfig::default()
             };
             let outcome = attempt_judged(
-                RotMode::Axis,
-                config,
+                (RotMode::Axis, config, None),
                 &mut KinematicStage1,
                 &mut KinematicStage2 { angle: U_PRIME },
                 distance,
@@ -169,6 +181,56 @@ fn knowing_the_face_up_finds_plans_that_skip_the_first_stage_1() {
         }
     }
     assert!(saved > 0, "some plans start on the face that is up");
+}
+
+/// Planning over plans of any length, priced in atomic actions (a Stage 1 at one turn), the
+/// hand spends exactly the table's least cost with perfect stages, never more than the
+/// cheapest optimal plan costs it, and less on some scrambles. Priced for risk (a Stage 1 at
+/// five turns), the same holds of five times its Stage 1 runs plus its Stage 2 runs.
+#[test]
+fn plans_of_any_length_cost_the_hand_what_the_table_says() {
+    let table = DistanceTable::build();
+    let (in_actions, for_risk) = (
+        CostTable::build(hand_price(1)),
+        CostTable::build(hand_price(5)),
+    );
+    let config = OperatorConfig {
+        plan_from_face_up: true,
+        ..OperatorConfig::default()
+    };
+    let mut saved = 0;
+    for (distance, seed) in [(3, 0), (6, 1), (9, 2), (11, 3), (14, 4)] {
+        let position = dexcube_cube::Position::of(
+            &scrambles_at_distance(&table, distance, 1, seed)[0].facelets,
+        );
+        let run = |any_length| {
+            let stages = (
+                &mut KinematicStage1 as &mut dyn Stage1,
+                &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
+            );
+            let outcome = attempt_judged(
+                (RotMode::Axis, config, any_length),
+                stages.0,
+                stages.1,
+                distance,
+                seed,
+            );
+            assert!(outcome.solved, "distance {distance}: {outcome:?}");
+            assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
+            outcome
+        };
+        let optimal = run(None);
+        let cheapest = run(Some(&in_actions));
+        let up = Some(Face::U.axis());
+        assert_eq!(cheapest.actions as u32, in_actions.cost(&position, up));
+        assert!(cheapest.actions <= optimal.actions, "distance {distance}");
+        saved += optimal.actions - cheapest.actions;
+        let safest = run(Some(&for_risk));
+        let risk = |o: &Outcome| 5 * o.stages.stage1_runs + o.stages.stage2_runs;
+        assert!(risk(&safest) <= risk(&optimal), "distance {distance}");
+        assert_eq!(risk(&safest) as u32, for_risk.cost(&position, up));
+    }
+    assert!(saved > 0, "a longer plan sometimes needs fewer actions");
 }
 
 /// A Stage 1 that leaves the cube upside down on its first `misses` runs.
@@ -290,8 +352,7 @@ fn the_opposite_face_up_makes_the_same_move_so_pair_mode_accepts_it() {
             seed,
         );
         let flipped = attempt_judged(
-            RotMode::Pair,
-            OperatorConfig::default(),
+            (RotMode::Pair, OperatorConfig::default(), None),
             &mut UpsideDownStage1,
             &mut KinematicStage2 { angle: U_PRIME },
             distance,
@@ -457,7 +518,7 @@ fn a_face_up_away_from_the_resting_point_skips_stage_1_only_when_told() {
             &mut KinematicStage1 as &mut dyn Stage1,
             &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
         );
-        let judged = (RotMode::Pair, config);
+        let judged = (RotMode::Pair, config, None);
         let outcome = solve_from(&scramble, aside, judged, stages, 0, &mut |_| {});
         assert!(outcome.solved, "{outcome:?}");
         actions.push(outcome.actions);
@@ -499,7 +560,7 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
             &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
         );
         let mut events = Vec::new();
-        let judged = (RotMode::Pair, config);
+        let judged = (RotMode::Pair, config, None);
         let outcome = solve_from(&scramble.moves, RESTING, judged, stages, 4, &mut |e| {
             events.push(e.clone())
         });
