@@ -1,7 +1,8 @@
 //! What the hand's plans need, per move distance, over Table I's scrambles: Stage 1 runs,
 //! Stage 2 turns and quarter turns for the cheapest optimal plan (the operator's default) and
 //! for the cheapest plan of any length with a Stage 1 priced PRICE turns (`--stage1-price`).
-//! No physics: it counts what each plan asks of perfect stages, with U up at the start.
+//! No physics: it counts what each plan asks of perfect stages, with U up at the start and
+//! the first move priced blind, as the operator does by default.
 //!
 //! `cargo run --release -p dexcube-operator --example plan_costs -- [PRICE] [SEED]`
 //! (defaults 5 and 0, Table I's seed).
@@ -39,7 +40,7 @@ fn main() {
         for scramble in &scrambles {
             let position = Position::of(&scramble.facelets);
             let optimal = table.cheapest_optimal(&position, hand_cost(None));
-            let any = costs.cheapest(&position, Some(Face::U.axis()));
+            let any = costs.cheapest(&position, None);
             for (k, plan) in [optimal, any].iter().enumerate() {
                 let (stage1, turns) = needs(plan);
                 sums[k] += stage1;
