@@ -63,7 +63,9 @@ pub struct OperatorArgs {
     /// Planning for the hand, take the cheapest plan of any length rather than of the optimal
     /// ones, with each U' turn priced 1 and each Stage 1 this many: a Stage 1 risks the cube
     /// more than a turn (in Table I, 1.4% of Stage 1 runs dropped it, 0.03% of Stage 2 runs).
-    /// 1 takes the plan of fewest atomic actions.
+    /// 1 takes the plan of fewest atomic actions. Measured in Table I it solved no more cubes
+    /// than the default: the shipped Stage 2 leaves the cube tilted, so a move about the axis
+    /// just turned needs a Stage 1 after all (results/TRAINING.md, session 14).
     #[arg(long, value_name = "TURNS", conflicts_with = "paper_operator",
           value_parser = clap::value_parser!(u32).range(1..=100))]
     pub stage1_price: Option<u32>,
