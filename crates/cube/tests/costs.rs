@@ -24,10 +24,9 @@ fn hand(repose: u32) -> impl Fn(Option<usize>, Move) -> u32 + Copy {
 /// What `solution` costs at `price`, the last move before it having turned about `before`.
 fn total(
     price: impl Fn(Option<usize>, Move) -> u32,
-    before: Option<usize>,
+    mut before: Option<usize>,
     solution: &[Move],
 ) -> u32 {
-    let mut before = before;
     solution
         .iter()
         .map(|&m| {

@@ -204,14 +204,10 @@ fn plans_of_any_length_cost_the_hand_what_the_table_says() {
             &scrambles_at_distance(&table, distance, 1, seed)[0].facelets,
         );
         let run = |any_length| {
-            let stages = (
-                &mut KinematicStage1 as &mut dyn Stage1,
-                &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
-            );
             let outcome = attempt_judged(
                 (RotMode::Axis, config, any_length),
-                stages.0,
-                stages.1,
+                &mut KinematicStage1,
+                &mut KinematicStage2 { angle: U_PRIME },
                 distance,
                 seed,
             );

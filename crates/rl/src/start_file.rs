@@ -49,12 +49,18 @@ pub fn save_starts(
         tensor(
             "state",
             vec![n, size],
-            starts.iter().flat_map(|s| s.state.clone()).collect(),
+            starts
+                .iter()
+                .flat_map(|s| s.state.iter().copied())
+                .collect(),
         ),
         tensor(
             "pose_goal",
             vec![n, POSE_GOAL],
-            starts.iter().flat_map(|s| s.pose_goal.clone()).collect(),
+            starts
+                .iter()
+                .flat_map(|s| s.pose_goal.iter().copied())
+                .collect(),
         ),
         tensor(
             "dropped",
