@@ -48,7 +48,8 @@ pub struct OperatorArgs {
     #[arg(long, value_enum)]
     pub opening: Option<Opening>,
     /// Planning for the hand, when Stage 1 is skipped for a face already up: `pose`, when
-    /// Stage 1's whole test passes; `face`, when the face is up wherever the cube lies.
+    /// Stage 1's whole test passes; `face`, when the face is up wherever the cube lies;
+    /// `top`, when the move's layer pair is top and bottom, however tilted.
     #[arg(long, value_enum, default_value_t = AlreadyUp::Pose, conflicts_with = "paper_operator")]
     pub already_up: AlreadyUp,
     /// With rollback, Stage 1 also needs the cube in its good state (every cubelet in line):
@@ -78,6 +79,19 @@ pub enum AlreadyUp {
     Pose,
     /// The face up within 0.1 rad, anywhere on the palm.
     Face,
+    /// The face or its opposite pointing more nearly up than any other, however the cube is
+    /// tilted or placed: how the second and third turns of a U, R or F move begin anyway.
+    Top,
+}
+
+impl AlreadyUp {
+    fn rule(self) -> dexcube_operator::AlreadyUp {
+        match self {
+            AlreadyUp::Pose => dexcube_operator::AlreadyUp::Pose,
+            AlreadyUp::Face => dexcube_operator::AlreadyUp::Face,
+            AlreadyUp::Top => dexcube_operator::AlreadyUp::Top,
+        }
+    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
@@ -105,7 +119,7 @@ impl OperatorArgs {
             rollback,
             plan_for_hand: !self.paper_operator,
             driving,
-            already_up_anywhere: self.already_up == AlreadyUp::Face,
+            already_up: self.already_up.rule(),
             stage1_good_state: self.stage1_good_state,
             plan_from_face_up: self.plan_from_face_up,
             ..OperatorConfig::default()
@@ -134,10 +148,11 @@ impl OperatorArgs {
             Some(steps) => format!("Stage 1 ends once held {steps} steps"),
             None => "whole Stage 1 episodes".to_string(),
         };
-        let skip = when(
-            config.already_up_anywhere,
-            ", no Stage 1 when the face is up anywhere on the palm",
-        );
+        let skip = match self.already_up {
+            AlreadyUp::Pose => "",
+            AlreadyUp::Face => ", no Stage 1 when the face is up anywhere on the palm",
+            AlreadyUp::Top => ", no Stage 1 when the layer pair is top and bottom",
+        };
         let square = when(
             config.stage1_good_state,
             ", Stage 1 also needs the good state",
@@ -172,7 +187,11 @@ impl OperatorArgs {
             Some(Opening::Gradual) => " --opening gradual",
             None => "",
         };
-        let already_up = when(self.already_up == AlreadyUp::Face, " --already-up face");
+        let already_up = match self.already_up {
+            AlreadyUp::Pose => "",
+            AlreadyUp::Face => " --already-up face",
+            AlreadyUp::Top => " --already-up top",
+        };
         let square = when(self.stage1_good_state, " --stage1-good-state");
         let first_move = when(self.plan_from_face_up, " --plan-from-face-up");
         let price = self

@@ -150,10 +150,9 @@ pub struct OperatorConfig {
     pub plan_for_hand: bool,
     /// How the policies are run on the cube.
     pub driving: Driving,
-    /// Planning for the hand, skip Stage 1 when the move's face is up within Stage 1's angle
-    /// test wherever the cube lies on the palm, rather than only when its whole test passes
-    /// (the position within 0.01 m of the resting point as well).
-    pub already_up_anywhere: bool,
+    /// Planning for the hand, when a move's face counts as already up, so that its Stage 1
+    /// is skipped.
+    pub already_up: AlreadyUp,
     /// With rollback, Stage 1 also needs the cube in its good state: a cube it leaves with a
     /// layer skewed is squared up and re-posed by randomisation, as a pose that is off is.
     pub stage1_good_state: bool,
@@ -171,11 +170,26 @@ impl Default for OperatorConfig {
             restores: 2,
             plan_for_hand: true,
             driving: Driving::FOR_HAND,
-            already_up_anywhere: false,
+            already_up: AlreadyUp::Pose,
             stage1_good_state: false,
             plan_from_face_up: false,
         }
     }
+}
+
+/// When the operator planning for the hand skips a move's Stage 1 because its face is
+/// already up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AlreadyUp {
+    /// Stage 1's own test passes: the face up within its angle test (0.1 rad) and the cube
+    /// within 0.01 m of its resting point.
+    Pose,
+    /// The face up within Stage 1's angle test, wherever the cube lies on the palm.
+    Face,
+    /// The move's layer pair lies top and bottom (the face or its opposite points more
+    /// nearly up than any other), however the cube is tilted or placed: what Stage 2 needs,
+    /// and how the second and third turns of a U, R or F move already begin.
+    Top,
 }
 
 /// Which face to bring up and how many U' turns make a move (the solver plans in U, R, F).
@@ -323,12 +337,12 @@ impl Operator<'_> {
 
     /// Whether the cube in `sim` already has `up` up, by the test that skips Stage 1.
     fn already_up(&self, sim: &Sim, up: Face) -> bool {
-        let up_at = if self.config.already_up_anywhere {
-            sim.object_pose().position
-        } else {
-            self.resting
-        };
-        (self.stage1_accepts)(sim, up_at, stage1_target(up))
+        let target = stage1_target(up);
+        match self.config.already_up {
+            AlreadyUp::Pose => (self.stage1_accepts)(sim, self.resting, target),
+            AlreadyUp::Face => (self.stage1_accepts)(sim, sim.object_pose().position, target),
+            AlreadyUp::Top => face_up(sim).axis() == up.axis(),
+        }
     }
 
     /// Both stages of one move, with the rollback checks; a failure ends the attempt.

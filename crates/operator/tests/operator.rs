@@ -12,12 +12,12 @@ use dexcube_operator::stages::{
     StageRun, Watch, pose_reached, randomise_pose,
 };
 use dexcube_operator::{
-    Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price, move_plan,
+    AlreadyUp, Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price, move_plan,
     set_up_scramble,
 };
 use dexcube_sim::cube::{CubeState, snap_layers};
-use dexcube_sim::rotation::Quat;
-use dexcube_sim::{Scene, SceneKind, Sim};
+use dexcube_sim::rotation::{self, Quat};
+use dexcube_sim::{Pose, Scene, SceneKind, Sim};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -57,7 +57,7 @@ fn attempt_judged(
     let scramble = scrambles_at_distance(&table, distance, 1, seed).remove(0);
     solve_from(
         &scramble.moves,
-        RESTING,
+        level_at(RESTING),
         judged,
         (stage1, stage2),
         seed,
@@ -65,15 +65,24 @@ fn attempt_judged(
     )
 }
 
+/// The cube upright (U up) at `position`.
+fn level_at(position: [f64; 3]) -> Pose {
+    Pose {
+        position,
+        orientation: rotation::IDENTITY,
+    }
+}
+
 /// How Stage 1's pose is judged, how the operator is configured, and the cost table of its
 /// plans of any length, if it plans so.
 type Judged<'a> = (RotMode, OperatorConfig, Option<&'a CostTable>);
 
-/// Solves `scramble`, made kinematically on the palm at `at`, with the given stages, Stage 1
-/// judged in `mode`, the operator configured by `config` and randomising from `seed`.
+/// Solves `scramble`, made kinematically and then placed on the palm at `at`, with the given
+/// stages, Stage 1 judged in `mode`, the operator configured by `config` and randomising from
+/// `seed`.
 fn solve_from(
     scramble: &[dexcube_cube::Move],
-    at: [f64; 3],
+    at: Pose,
     (mode, config, any_length): Judged,
     (stage1, stage2): (&mut dyn Stage1, &mut dyn Stage2),
     seed: u64,
@@ -81,7 +90,9 @@ fn solve_from(
 ) -> Outcome {
     let table = DistanceTable::build();
     let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
-    set_up_scramble(&mut sim, scramble, at);
+    set_up_scramble(&mut sim, scramble, at.position);
+    sim.set_object_pose(&at);
+    sim.forward();
     let accepts = pose_reached(RotGoal::paper(mode));
     let mut operator = Operator {
         config,
@@ -497,29 +508,42 @@ fn shipped_stages() -> (dexcube_operator::eval::LoadedStages, [f64; 3]) {
     (files.load(resting).unwrap(), resting)
 }
 
-/// A cube with the right face up but 2 cm from its resting point: Stage 1's whole test
-/// refuses that pose, so by default the operator re-poses it first; told that the face up is
-/// enough (`already_up_anywhere`), it turns the layer at once.
+/// A cube with U up but 2 cm from its resting point, level or tilted by 0.3 rad, to be turned
+/// U'. Stage 1's whole test refuses both (`Pose`), so the operator re-poses the cube first;
+/// the face's angle test alone (`Face`) accepts the level one; the layer pair top and bottom
+/// (`Top`) accepts both, and the layer is turned at once.
 #[test]
-fn a_face_up_away_from_the_resting_point_skips_stage_1_only_when_told() {
+fn a_face_up_off_its_pose_skips_stage_1_only_as_told() {
     let scramble = dexcube_cube::parse_moves("U").unwrap();
-    let aside = [RESTING[0] + 0.02, RESTING[1], RESTING[2]];
+    let position = [RESTING[0] + 0.02, RESTING[1], RESTING[2]];
+    let level = rotation::IDENTITY;
+    let tilted = rotation::about([1.0, 0.0, 0.0], 0.3);
     let mut actions = Vec::new();
-    for already_up_anywhere in [false, true] {
-        let config = OperatorConfig {
-            already_up_anywhere,
-            ..OperatorConfig::default()
-        };
-        let stages = (
-            &mut KinematicStage1 as &mut dyn Stage1,
-            &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
-        );
-        let judged = (RotMode::Pair, config, None);
-        let outcome = solve_from(&scramble, aside, judged, stages, 0, &mut |_| {});
-        assert!(outcome.solved, "{outcome:?}");
-        actions.push(outcome.actions);
+    for orientation in [level, tilted] {
+        for already_up in [AlreadyUp::Pose, AlreadyUp::Face, AlreadyUp::Top] {
+            let config = OperatorConfig {
+                already_up,
+                ..OperatorConfig::default()
+            };
+            let stages = (
+                &mut KinematicStage1 as &mut dyn Stage1,
+                &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
+            );
+            let judged = (RotMode::Pair, config, None);
+            let at = Pose {
+                position,
+                orientation,
+            };
+            let outcome = solve_from(&scramble, at, judged, stages, 0, &mut |_| {});
+            assert!(outcome.solved, "{outcome:?}");
+            actions.push(outcome.actions);
+        }
     }
-    assert_eq!(actions, [2, 1], "Stage 1 then U', or U' alone");
+    assert_eq!(
+        actions,
+        [2, 1, 1, 2, 2, 1],
+        "Stage 1 then U', or U' alone: level (Pose, Face, Top), then tilted"
+    );
 }
 
 /// A Stage 1 that reaches its pose but leaves the layer on the cube's right skewed by 0.3 rad
@@ -557,7 +581,7 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
         );
         let mut events = Vec::new();
         let judged = (RotMode::Pair, config, None);
-        let outcome = solve_from(&scramble.moves, RESTING, judged, stages, 4, &mut |e| {
+        let outcome = solve_from(&scramble.moves, level_at(RESTING), judged, stages, 4, &mut |e| {
             events.push(e.clone())
         });
         assert!(outcome.solved, "{outcome:?}");
