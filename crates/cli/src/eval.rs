@@ -18,7 +18,7 @@ use dexcube_env::{
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
-use dexcube_operator::stages::{Driving, PolicyStage1, PolicyStage2};
+use dexcube_operator::stages::{Driving, PolicyStage1, PolicyStage2, Steadying};
 use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
@@ -70,6 +70,25 @@ pub struct OperatorArgs {
     #[arg(long, value_name = "TURNS", conflicts_with = "paper_operator",
           value_parser = clap::value_parser!(u32).range(1..=100))]
     pub stage1_price: Option<u32>,
+    /// A reflex against drops: whenever the cube strays this far across the palm from its
+    /// resting point during Stage 1, the hand takes the neutral action for --steady-steps
+    /// control steps before the policy goes on. Off by default.
+    #[arg(long, value_name = "METRES", value_parser = positive_metres)]
+    pub steady_radius: Option<f64>,
+    /// Control steps the hand holds still each time --steady-radius fires.
+    #[arg(long, value_name = "STEPS", default_value_t = 5, requires = "steady_radius",
+          value_parser = clap::value_parser!(u64).range(1..=100))]
+    pub steady_steps: u64,
+}
+
+/// A distance in metres, above 0 and at most 0.2 (beyond that the cube is off the palm).
+fn positive_metres(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(metres) if metres > 0.0 && metres <= 0.2 => Ok(metres),
+        _ => Err(format!(
+            "'{text}' is not a distance in metres above 0 and at most 0.2 (e.g. 0.03)"
+        )),
+    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
@@ -115,6 +134,10 @@ impl OperatorArgs {
         if let Some(opening) = self.opening {
             driving.gradual_opening = opening == Opening::Gradual;
         }
+        driving.stage1_steadying = self.steady_radius.map(|radius| Steadying {
+            radius,
+            steps: self.steady_steps as usize,
+        });
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
@@ -164,8 +187,14 @@ impl OperatorArgs {
         let any_length = self.stage1_price.map_or(String::new(), |price| {
             format!(", plans of any length with a Stage 1 priced {price} turns")
         });
+        let steadying = driving.stage1_steadying.map_or(String::new(), |s| {
+            format!(
+                ", Stage 1 holds still {} steps when the cube strays {} m",
+                s.steps, s.radius
+            )
+        });
         format!(
-            "{planner}{any_length}, opening the hand {opening}, {stage1}{skip}{square}{first_move}"
+            "{planner}{any_length}, opening the hand {opening}, {stage1}{steadying}{skip}{square}{first_move}"
         )
     }
 
@@ -197,7 +226,13 @@ impl OperatorArgs {
         let price = self
             .stage1_price
             .map_or(String::new(), |price| format!(" --stage1-price {price}"));
-        format!("{paper}{held}{opening}{already_up}{square}{first_move}{price}")
+        let steady = self.steady_radius.map_or(String::new(), |radius| {
+            format!(
+                " --steady-radius {radius} --steady-steps {}",
+                self.steady_steps
+            )
+        });
+        format!("{paper}{held}{opening}{already_up}{square}{first_move}{price}{steady}")
     }
 }
 

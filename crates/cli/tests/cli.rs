@@ -80,6 +80,8 @@ fn bad_input_fails_cleanly_with_a_reason() {
     assert_clean_failure(&o, 2, "cannot open batch file /no/such/file");
     let o = dexcube(&["scramble", "--distance", "15"], "");
     assert_clean_failure(&o, 2, "largest distance is 14");
+    let o = dexcube(&["eval", "--steady-radius", "0"], "");
+    assert_clean_failure(&o, 2, "not a distance in metres above 0");
 }
 
 #[test]
@@ -213,6 +215,8 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
         &["--opening", "at-once"],
         &["--plan-from-face-up"],
         &["--stage1-price", "5"],
+        &["--already-up", "top"],
+        &["--steady-radius", "0.03"],
     ] {
         let refused = dexcube(&[&args[..], other].concat(), "");
         assert_clean_failure(&refused, 2, "or another operator");

@@ -62,7 +62,7 @@ pub struct StageRun {
 /// the policy's whole episode; the operator planning for the hand does neither
 /// (`Driving::FOR_HAND`): both were measured in the operator (`results/TRAINING.md`,
 /// session 6).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Driving {
     /// Open the hand from where the last stage left it by moving its targets to the flat
     /// hand step by step over the first settling steps, rather than at once.
@@ -70,13 +70,65 @@ pub struct Driving {
     /// End Stage 1 once its pose test has passed for this many control steps running,
     /// rather than after the policy's whole episode.
     pub stage1_held_steps: Option<usize>,
+    /// During Stage 1, let the cube steady itself whenever it strays from its resting point.
+    pub stage1_steadying: Option<Steadying>,
 }
 
 impl Driving {
     pub const FOR_HAND: Driving = Driving {
         gradual_opening: true,
         stage1_held_steps: Some(5),
+        stage1_steadying: None,
     };
+}
+
+/// A reflex against drops in Stage 1: when the cube strays more than `radius` metres across
+/// the palm from its resting point, the hand takes the neutral action for `steps` control
+/// steps, and then the policy goes on. It fires again only once the cube has come back within
+/// the radius. Nearly every drop begins with the cube sliding away from the centre of the
+/// palm (`results/TRAINING.md`, session 15).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Steadying {
+    pub radius: f64,
+    pub steps: usize,
+}
+
+/// One Stage 1 run's [`Steadying`]: whether the hand holds still at this step.
+pub struct Steadier {
+    steadying: Steadying,
+    centre: [f64; 3],
+    armed: bool,
+    holding_for: usize,
+}
+
+impl Steadier {
+    pub fn new(steadying: Steadying, centre: [f64; 3]) -> Steadier {
+        Steadier {
+            steadying,
+            centre,
+            armed: true,
+            holding_for: 0,
+        }
+    }
+
+    /// Whether the hand takes the neutral action at this step, given where the cube is.
+    pub fn holds(&mut self, sim: &Sim) -> bool {
+        let [x, y, _] = sim.object_pose().position;
+        let strayed = (x - self.centre[0]).hypot(y - self.centre[1]) > self.steadying.radius;
+        if !strayed {
+            self.armed = true;
+        }
+        if self.holding_for > 0 {
+            self.holding_for -= 1;
+            return true;
+        }
+        if strayed && self.armed {
+            self.armed = false;
+            self.holding_for = self.steadying.steps.saturating_sub(1);
+            return true;
+        }
+        false
+    }
 }
 
 /// Control steps that open the hand and let the cube settle before a stage's policy acts
@@ -221,9 +273,20 @@ impl Stage1 for PolicyStage1 {
                 running >= steps
             })
         };
+        let mut steadier = self
+            .driving
+            .stage1_steadying
+            .map(|steadying| Steadier::new(steadying, position));
+        let act = |sim: &Sim| {
+            if steadier.as_mut().is_some_and(|steadier| steadier.holds(sim)) {
+                vec![0.0; HAND_ACTUATORS]
+            } else {
+                policy.act(&base_observation(sim), &goal)
+            }
+        };
         drive(
             sim,
-            |sim| policy.act(&base_observation(sim), &goal),
+            act,
             position[2],
             self.driving.gradual_opening,
             &mut held,

@@ -9,7 +9,7 @@ use dexcube_env::{
 };
 use dexcube_operator::stages::{
     Driving, KinematicStage1, KinematicStage2, OPENING_STEPS, RecordingStage1, Stage1, Stage2,
-    StageRun, Watch, pose_reached, randomise_pose,
+    StageRun, Steadier, Steadying, Watch, pose_reached, randomise_pose,
 };
 use dexcube_operator::{
     AlreadyUp, Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price, move_plan,
@@ -543,6 +543,41 @@ fn a_face_up_off_its_pose_skips_stage_1_only_as_told() {
         actions,
         [2, 1, 1, 2, 2, 1],
         "Stage 1 then U', or U' alone: level (Pose, Face, Top), then tilted"
+    );
+}
+
+/// Stage 1's reflex against drops holds the hand still for its steps once the cube strays
+/// across the palm past its radius (lifting it does not count), and fires again only after
+/// the cube has come back within it.
+#[test]
+fn steadying_holds_the_hand_still_once_per_stray() {
+    let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
+    let steadying = Steadying {
+        radius: 0.03,
+        steps: 3,
+    };
+    let mut steadier = Steadier::new(steadying, RESTING);
+    let mut holds = Vec::new();
+    let offsets = [
+        (0.0, 0.0),
+        (0.0, 0.04),
+        (0.04, 0.0),
+        (0.04, 0.0),
+        (0.04, 0.0),
+        (0.04, 0.0),
+        (0.02, 0.0),
+        (0.04, 0.0),
+    ];
+    for (across, up) in offsets {
+        let position = [RESTING[0] + across, RESTING[1], RESTING[2] + up];
+        sim.set_object_pose(&level_at(position));
+        sim.forward();
+        holds.push(steadier.holds(&sim));
+    }
+    assert_eq!(
+        holds,
+        [false, false, true, true, true, false, false, true],
+        "still for 3 steps after the first stray, not again until the cube came back"
     );
 }
 
