@@ -40,7 +40,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|(_, a)| a)
         .collect();
     let Some(path) = positional.first() else {
-        return Err("usage: stage1_drops STARTS [RADIUS STEPS] [--dropped-only] [--policy PREFIX]".into());
+        return Err(
+            "usage: stage1_drops STARTS [RADIUS STEPS] [--dropped-only] [--policy PREFIX]".into(),
+        );
     };
     let steadying = match positional.get(1..3) {
         Some([radius, steps]) => Some(Steadying {
@@ -53,10 +55,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let starts: Arc<[_]> = starts.into();
     let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
     let goal = PolicyStage1::trained_goal(&policy, RotMode::Pair, &prefix)?;
-    let mut env = CubeRotEnv::with_scene(Scene::load(SceneKind::Cube)?, goal).with_starts(StartMix {
-        starts: starts.clone(),
-        pick: StartPick::Numbered,
-    });
+    let mut env =
+        CubeRotEnv::with_scene(Scene::load(SceneKind::Cube)?, goal).with_starts(StartMix {
+            starts: starts.clone(),
+            pick: StartPick::Numbered,
+        });
     let centre = env.resting_point();
     println!("{} starts from `{}`", starts.len(), origin.command);
 

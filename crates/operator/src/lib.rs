@@ -11,6 +11,6 @@ pub mod operator;
 pub mod stages;
 
 pub use operator::{
-    AlreadyUp, Event, Failure, Operator, OperatorConfig, Outcome, Planner, StageRecord, hand_cost, hand_price,
-    move_plan, set_up_scramble,
+    AlreadyUp, Event, Failure, Operator, OperatorConfig, Outcome, Planner, StageRecord, hand_cost,
+    hand_price, move_plan, set_up_scramble,
 };

@@ -278,7 +278,10 @@ impl Stage1 for PolicyStage1 {
             .stage1_steadying
             .map(|steadying| Steadier::new(steadying, position));
         let act = |sim: &Sim| {
-            if steadier.as_mut().is_some_and(|steadier| steadier.holds(sim)) {
+            if steadier
+                .as_mut()
+                .is_some_and(|steadier| steadier.holds(sim))
+            {
                 vec![0.0; HAND_ACTUATORS]
             } else {
                 policy.act(&base_observation(sim), &goal)

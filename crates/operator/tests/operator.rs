@@ -12,8 +12,8 @@ use dexcube_operator::stages::{
     StageRun, Steadier, Steadying, Watch, pose_reached, randomise_pose,
 };
 use dexcube_operator::{
-    AlreadyUp, Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price, move_plan,
-    set_up_scramble,
+    AlreadyUp, Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price,
+    move_plan, set_up_scramble,
 };
 use dexcube_sim::cube::{CubeState, snap_layers};
 use dexcube_sim::rotation::{self, Quat};
@@ -616,9 +616,14 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
         );
         let mut events = Vec::new();
         let judged = (RotMode::Pair, config, None);
-        let outcome = solve_from(&scramble.moves, level_at(RESTING), judged, stages, 4, &mut |e| {
-            events.push(e.clone())
-        });
+        let outcome = solve_from(
+            &scramble.moves,
+            level_at(RESTING),
+            judged,
+            stages,
+            4,
+            &mut |e| events.push(e.clone()),
+        );
         assert!(outcome.solved, "{outcome:?}");
         assert!(outcome.stages.stage1_runs >= 2, "{outcome:?}");
         let retried = events.iter().any(|e| {
