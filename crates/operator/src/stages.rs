@@ -85,8 +85,10 @@ impl Driving {
 /// A reflex against drops in Stage 1: when the cube strays more than `radius` metres across
 /// the palm from its resting point, the hand takes the neutral action for `steps` control
 /// steps, and then the policy goes on. It fires again only once the cube has come back within
-/// the radius. Nearly every drop begins with the cube sliding away from the centre of the
-/// palm (`results/TRAINING.md`, session 15).
+/// the radius. Every drop begins with the cube sliding away from the centre of the palm, but
+/// so do half of the runs that keep it: in the operator, holding still 5 steps past 3 cm
+/// missed more poses and dropped more cubes (`results/TRAINING.md`, session 15), so it
+/// is off by default.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Steadying {
     pub radius: f64,
