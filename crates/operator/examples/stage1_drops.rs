@@ -14,9 +14,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use dexcube_env::{CubeRotEnv, GoalEnv, RotMode, SimulatedEnv, StartMix, StartPick};
-use dexcube_operator::stages::{PolicyStage1, Steadier, Steadying};
+use dexcube_operator::stages::{
+    PolicyStage1, Steadier, Steadying, distance_across_palm, steadied_action,
+};
 use dexcube_rl::Policy;
-use dexcube_sim::{HAND_ACTUATORS, Scene, SceneKind};
+use dexcube_sim::{Scene, SceneKind};
 
 const RADII: [f64; 3] = [0.03, 0.04, 0.05];
 
@@ -77,18 +79,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             reached: false,
         };
         for step in 0..dexcube_env::EPISODE_STEPS {
-            let [x, y, _] = env.sim().object_pose().position;
-            let off = (x - centre[0]).hypot(y - centre[1]);
+            let off = distance_across_palm(env.sim(), centre);
             for (first, radius) in replay.strayed_at.iter_mut().zip(RADII) {
                 if off > radius && first.is_none() {
                     *first = Some(step);
                 }
             }
-            let action = if steadier.as_mut().is_some_and(|s| s.holds(env.sim())) {
-                vec![0.0; HAND_ACTUATORS]
-            } else {
+            let action = steadied_action(steadier.as_mut(), env.sim(), || {
                 policy.act(&observation.observation, &observation.desired_goal)
-            };
+            });
             let transition = env.step(&action);
             replay.reached = transition.info.is_success;
             observation = transition.observation;

@@ -115,8 +115,7 @@ impl Steadier {
 
     /// Whether the hand takes the neutral action at this step, given where the cube is.
     pub fn holds(&mut self, sim: &Sim) -> bool {
-        let [x, y, _] = sim.object_pose().position;
-        let strayed = (x - self.centre[0]).hypot(y - self.centre[1]) > self.steadying.radius;
+        let strayed = distance_across_palm(sim, self.centre) > self.steadying.radius;
         if !strayed {
             self.armed = true;
         }
@@ -131,6 +130,26 @@ impl Steadier {
         }
         false
     }
+}
+
+/// The action at this step of a Stage 1 run: the neutral action while `steadier` holds the
+/// hand still, otherwise the policy's (`act`).
+pub fn steadied_action(
+    steadier: Option<&mut Steadier>,
+    sim: &Sim,
+    act: impl FnOnce() -> Vec<f64>,
+) -> Vec<f64> {
+    if steadier.is_some_and(|steadier| steadier.holds(sim)) {
+        vec![0.0; HAND_ACTUATORS]
+    } else {
+        act()
+    }
+}
+
+/// How far the cube lies from `centre` across the palm (horizontally), metres.
+pub fn distance_across_palm(sim: &Sim, centre: [f64; 3]) -> f64 {
+    let [x, y, _] = sim.object_pose().position;
+    (x - centre[0]).hypot(y - centre[1])
 }
 
 /// Control steps that open the hand and let the cube settle before a stage's policy acts
@@ -280,14 +299,9 @@ impl Stage1 for PolicyStage1 {
             .stage1_steadying
             .map(|steadying| Steadier::new(steadying, position));
         let act = |sim: &Sim| {
-            if steadier
-                .as_mut()
-                .is_some_and(|steadier| steadier.holds(sim))
-            {
-                vec![0.0; HAND_ACTUATORS]
-            } else {
+            steadied_action(steadier.as_mut(), sim, || {
                 policy.act(&base_observation(sim), &goal)
-            }
+            })
         };
         drive(
             sim,
