@@ -3,7 +3,8 @@
 //! must end up vertical (in pair mode either end of it may point up). It prints how many starts,
 //! and how many of them the recorded policy dropped the cube from, by how far that axis
 //! leans from vertical at the start and, for the quarter flips, by the compass direction it
-//! points in across the palm (azimuth in the world frame; the fingertips lie towards -x).
+//! points in across the palm (azimuth in the world frame; the fingertips lie towards -x), and
+//! by how far the cube itself leans, whichever face it rests on.
 //!
 //! `cargo run --release -p dexcube-operator --example stage1_start_geometry -- STARTS...`
 
@@ -21,12 +22,21 @@ const TILT_BINS: [(f64, f64); 6] = [
     (85.0, 90.1),
     (0.0, 90.1),
 ];
+const LEAN_BINS: [(f64, f64); 5] = [
+    (0.0, 5.0),
+    (5.0, 10.0),
+    (10.0, 20.0),
+    (20.0, 35.0),
+    (35.0, 55.0),
+];
 /// The quarter flips among [`TILT_BINS`].
 const FLIP_BINS: [(f64, f64); 4] = [(45.0, 70.0), (70.0, 80.0), (80.0, 85.0), (85.0, 90.1)];
 
 /// One start: how far the axis to bring up leans from vertical, its azimuth, in degrees, and
 /// whether the recorded policy dropped the cube from there.
 struct Start {
+    /// How far the cube's most nearly vertical axis leans, whichever face it rests on.
+    lean: f64,
     tilt: f64,
     azimuth: f64,
     dropped: bool,
@@ -51,11 +61,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 start.pose_goal[6],
             ];
             let in_cube = rotate(&conj(&target), [0.0, 0.0, 1.0]);
-            let mut axis = rotate(&env.sim().object_pose().orientation, in_cube);
+            let orientation = env.sim().object_pose().orientation;
+            let lean = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+                .map(|a| {
+                    rotate(&orientation, a)[2]
+                        .abs()
+                        .min(1.0)
+                        .acos()
+                        .to_degrees()
+                })
+                .into_iter()
+                .fold(f64::INFINITY, f64::min);
+            let mut axis = rotate(&orientation, in_cube);
             if axis[2] < 0.0 {
                 axis = axis.map(|a| -a);
             }
             starts.push(Start {
+                lean,
                 tilt: axis[2].clamp(-1.0, 1.0).acos().to_degrees(),
                 azimuth: axis[1].atan2(axis[0]).to_degrees(),
                 dropped: start.dropped,
@@ -75,6 +97,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (n, drops) = count(&|s| (low..high).contains(&s.tilt));
         let rate = 100.0 * drops as f64 / n.max(1) as f64;
         println!("  {low:>2.0} to {high:>2.0} degrees: {n} starts, {drops} dropped ({rate:.1}%)");
+    }
+    println!("by the lean of the cube itself, whichever face it rests on:");
+    for (low, high) in LEAN_BINS {
+        let (n, drops) = count(&|s| (low..high).contains(&s.lean));
+        println!("  {low:>2.0} to {high:>2.0} degrees: {n} starts, {drops} dropped");
     }
     println!(
         "quarter flips: dropped / starts, by lean (rows) and the axis's azimuth (columns, degrees)"
