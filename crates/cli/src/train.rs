@@ -94,6 +94,10 @@ pub struct TrainArgs {
     /// With --starts, the probability that an episode begins from one of them.
     #[arg(long, default_value_t = 0.5, value_name = "P", requires = "starts")]
     start_share: f64,
+    /// With --starts, how many times as often a start the recorded policy dropped the cube
+    /// from is drawn as one it kept the cube from (1: all alike).
+    #[arg(long, default_value_t = 1.0, value_name = "W", requires = "starts")]
+    dropped_weight: f64,
 }
 
 /// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
@@ -142,18 +146,23 @@ fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Resu
     let Ok(begun) = dexcube_rl::train::RunCurve::read(run) else {
         return Ok(());
     };
-    let flags = |starts: Option<String>, share: Option<f64>| match (starts, share) {
-        (Some(starts), Some(share)) => format!("--starts {starts} --start-share {share}"),
+    let flags = |starts: Option<String>, share: Option<f64>, weight: f64| match (starts, share) {
+        (Some(starts), Some(share)) => {
+            format!("--starts {starts} --start-share {share} --dropped-weight {weight}")
+        }
         _ => "no --starts".to_string(),
     };
     let environment = &begun.environment;
     let begun = flags(
         environment["starts"].as_str().map(str::to_string),
         environment["start_share"].as_f64(),
+        // Runs from before the weight drew every start alike.
+        environment["dropped_weight"].as_f64().unwrap_or(1.0),
     );
     let now = flags(
         args.starts.as_ref().map(|p| p.display().to_string()),
         Some(args.start_share),
+        args.dropped_weight,
     );
     if begun != now {
         bail!(
@@ -185,6 +194,12 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         bail!(
             "--start-share must be between 0 and 1, not {}",
             args.start_share
+        );
+    }
+    if !(args.dropped_weight.is_finite() && args.dropped_weight > 0.0) {
+        bail!(
+            "--dropped-weight must be a positive number, not {}",
+            args.dropped_weight
         );
     }
     let suffix = args
@@ -273,6 +288,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "init_actor": args.init_actor.as_ref().map(|p| p.display().to_string()),
             "starts": args.starts.as_ref().map(|p| p.display().to_string()),
             "start_share": args.starts.as_ref().map(|_| args.start_share),
+            "dropped_weight": args.starts.as_ref().map(|_| args.dropped_weight),
         }),
     };
     eprintln!(
@@ -288,7 +304,10 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             let starts = match &args.starts {
                 Some(path) => Some(StartMix {
                     starts: starts_for(path, &scene)?,
-                    pick: StartPick::Share(args.start_share),
+                    pick: StartPick::Share {
+                        share: args.start_share,
+                        dropped_weight: args.dropped_weight,
+                    },
                 }),
                 None => None,
             };

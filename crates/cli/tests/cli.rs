@@ -422,6 +422,11 @@ fn train_refuses_settings_it_cannot_run() {
             "--start-share must be between 0 and 1",
         ),
         (
+            &["rot", "--starts", "s", "--dropped-weight", "0"],
+            "--dropped-weight must be a positive number",
+        ),
+        (&["rot", "--dropped-weight", "5"], "--starts <FILE>"),
+        (
             &["rot", "--object", "cube", "--starts", "/no/such/starts"],
             "record starts with `dexcube eval",
         ),
@@ -444,38 +449,44 @@ fn train_refuses_settings_it_cannot_run() {
     }
 }
 
-/// A run resumes only with the recorded starts it began with (here: none), so that its card
-/// never names starts it did not train on.
+/// A run resumes only with the recorded starts it began with, and drawn as they were, so
+/// that its card never names starts it did not train on: session 12's run began with none,
+/// and session 13's with starts all drawn alike (a card from before `--dropped-weight`).
 #[test]
 fn train_resumes_only_with_the_starts_it_began_with() {
-    let run = std::env::temp_dir().join("dexcube-cli-resume-starts");
-    let _ = std::fs::remove_dir_all(&run);
-    std::fs::create_dir_all(run.join("checkpoint")).unwrap();
-    let committed = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../results/training/rot-pair-cube-square-anchor5-seed0/checkpoint/state.json"
-    );
-    std::fs::copy(committed, run.join("checkpoint/state.json")).unwrap();
-    let o = dexcube(
-        &[
-            "train",
-            "rot",
-            "--mode",
-            "pair",
-            "--object",
-            "cube",
-            "--square",
-            "--resume",
-            run.to_str().unwrap(),
-            "--starts",
-            "s.safetensors",
-        ],
-        "",
-    );
+    let resume = |committed_run: &str, starts: &[&str]| {
+        let run = std::env::temp_dir().join(format!("dexcube-cli-resume-{committed_run}"));
+        let _ = std::fs::remove_dir_all(&run);
+        std::fs::create_dir_all(run.join("checkpoint")).unwrap();
+        let committed = format!(
+            "{}/../../results/training/{committed_run}/checkpoint/state.json",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        std::fs::copy(committed, run.join("checkpoint/state.json")).unwrap();
+        let run = run.to_str().unwrap().to_string();
+        let square = ["rot", "--mode", "pair", "--object", "cube", "--square"];
+        let args = [&["train"][..], &square, &["--resume", &run], starts].concat();
+        dexcube(&args, "")
+    };
     assert_clean_failure(
-        &o,
+        &resume(
+            "rot-pair-cube-square-anchor5-seed0",
+            &["--starts", "s.safetensors"],
+        ),
         2,
         "began with no --starts; resume it with the same, not --starts s.safetensors",
+    );
+    let recorded = "runs/starts-train-seed1.safetensors";
+    assert_clean_failure(
+        &resume(
+            "rot-pair-cube-square-starts-seed0",
+            &["--starts", recorded, "--dropped-weight", "5"],
+        ),
+        2,
+        &format!(
+            "began with --starts {recorded} --start-share 0.5 --dropped-weight 1; resume it \
+             with the same, not --starts {recorded} --start-share 0.5 --dropped-weight 5"
+        ),
     );
 }
 

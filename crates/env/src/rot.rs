@@ -28,7 +28,7 @@ use rand::Rng;
 use crate::goal::{Goal, RotGoal, RotMode};
 use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
 use crate::random::uniform_rotation;
-use crate::starts::{RecordedStart, StartMix, StartPick};
+use crate::starts::{RecordedStart, StartMix, StartPick, weighted_start};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// The paper's three Stage 1 targets, `[w, x, y, z]`.
@@ -192,7 +192,10 @@ impl GoalEnv for CubeRotEnv {
             let rng = &mut self.hand.rng;
             let k = match (pick, seed) {
                 (StartPick::Numbered, Some(seed)) => Some(seed as usize % starts.len()),
-                (StartPick::Share(share), _) if rng.random::<f64>() >= share => None,
+                (StartPick::Share { share, .. }, _) if rng.random::<f64>() >= share => None,
+                (StartPick::Share { dropped_weight, .. }, _) if dropped_weight != 1.0 => {
+                    Some(weighted_start(&starts, dropped_weight, rng.random()))
+                }
                 _ => Some(rng.random_range(0..starts.len())),
             };
             if let Some(Ok(first)) = k.map(|k| self.reset_from(&starts[k])) {

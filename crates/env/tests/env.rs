@@ -449,7 +449,11 @@ fn cube_rot_env_resets_from_recorded_starts() {
     numbered.reset(Some(0));
     assert_eq!(numbered.sim().physics_state(), starts[0].state);
 
-    let (mut never, mut always) = (env(StartPick::Share(0.0)), env(StartPick::Share(1.0)));
+    let share = |share| StartPick::Share {
+        share,
+        dropped_weight: 1.0,
+    };
+    let (mut never, mut always) = (env(share(0.0)), env(share(1.0)));
     let recorded = |env: &CubeRotEnv| starts.iter().any(|s| s.state == env.sim().physics_state());
     for seed in 0..8 {
         never.reset(Some(seed));
