@@ -193,6 +193,8 @@ impl GoalEnv for CubeRotEnv {
             let k = match (pick, seed) {
                 (StartPick::Numbered, Some(seed)) => Some(seed as usize % starts.len()),
                 (StartPick::Share { share, .. }, _) if rng.random::<f64>() >= share => None,
+                // Weight 1 keeps the uniform draw, so runs from before the weight draw the
+                // same starts when resumed.
                 (StartPick::Share { dropped_weight, .. }, _) if dropped_weight != 1.0 => {
                     Some(weighted_start(&starts, dropped_weight, rng.random()))
                 }

@@ -11,8 +11,11 @@
 use std::path::Path;
 
 use dexcube_env::{CubeRotEnv, RotGoal, RotMode, SimulatedEnv};
-use dexcube_sim::rotation::{conj, rotate};
+use dexcube_sim::cube::{face_normal, face_toward};
+use dexcube_sim::rotation::{Quat, rotate};
 use dexcube_sim::{Scene, SceneKind};
+
+const UP: [f64; 3] = [0.0, 0.0, 1.0];
 
 const TILT_BINS: [(f64, f64); 6] = [
     (0.0, 45.0),
@@ -54,31 +57,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (recorded, _) = dexcube_rl::start_file::load_starts(Path::new(path))?;
         for start in &recorded {
             env.reset_from(start)?;
-            let target = [
-                start.pose_goal[3],
-                start.pose_goal[4],
-                start.pose_goal[5],
-                start.pose_goal[6],
-            ];
-            let in_cube = rotate(&conj(&target), [0.0, 0.0, 1.0]);
+            let target: Quat = start.pose_goal[3..7].try_into()?;
             let orientation = env.sim().object_pose().orientation;
-            let lean = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-                .map(|a| {
-                    rotate(&orientation, a)[2]
-                        .abs()
-                        .min(1.0)
-                        .acos()
-                        .to_degrees()
-                })
-                .into_iter()
-                .fold(f64::INFINITY, f64::min);
-            let mut axis = rotate(&orientation, in_cube);
+            // A face's outward normal in the world, and how far it leans from vertical.
+            let normal = |face| rotate(&orientation, face_normal(face));
+            let leaning = |v: [f64; 3]| v[2].clamp(-1.0, 1.0).acos().to_degrees();
+            let lean = leaning(normal(face_toward(&orientation, UP)));
+            // Pair mode: either end of the target's up axis may come up; take the higher.
+            let mut axis = normal(face_toward(&target, UP));
             if axis[2] < 0.0 {
                 axis = axis.map(|a| -a);
             }
             starts.push(Start {
                 lean,
-                tilt: axis[2].clamp(-1.0, 1.0).acos().to_degrees(),
+                tilt: leaning(axis),
                 azimuth: axis[1].atan2(axis[0]).to_degrees(),
                 dropped: start.dropped,
             });
