@@ -54,6 +54,33 @@ pub struct Series {
     pub band: Option<Vec<(f64, f64, f64)>>,
 }
 
+const LEGEND_FONT: (&str, u32) = ("sans-serif", 14);
+
+/// Breaks `label` at spaces into lines no wider than `width` pixels in the legend's font, so a
+/// long label wraps inside the legend panel instead of running off the image. A single word
+/// wider than the panel keeps a line of its own.
+fn wrapped<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    label: &str,
+    width: u32,
+) -> Result<Vec<String>, String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in label.split_whitespace() {
+        let joined = match lines.last() {
+            Some(line) => format!("{line} {word}"),
+            None => word.to_string(),
+        };
+        let (joined_width, _) = area
+            .estimate_text_size(&joined, &LEGEND_FONT.into_text_style(area))
+            .map_err(|e| e.to_string())?;
+        match lines.last_mut() {
+            Some(line) if joined_width <= width => *line = joined,
+            _ => lines.push(word.to_string()),
+        }
+    }
+    Ok(lines)
+}
+
 /// Draws `series` against a shared x axis into a 1000x500 PNG, y from 0 to `y_max`, with the
 /// legend in a panel of its own on the right, where it cannot cover a curve. Series without
 /// points are left out.
@@ -90,6 +117,7 @@ pub fn line_plot(
             .draw()
             .map_err(|e| e.to_string())?;
         let drawn = series.iter().filter(|s| !s.points.is_empty());
+        let mut legend_y = 60;
         for (i, s) in drawn.enumerate() {
             let colour = TAB10[i % TAB10.len()].to_rgba();
             if let Some(band) = &s.band {
@@ -103,15 +131,45 @@ pub fn line_plot(
             chart
                 .draw_series(LineSeries::new(s.points.clone(), colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?;
-            let y = 60 + 24 * i as i32;
             legend_area
-                .draw(&PathElement::new([(0, y), (24, y)], colour.stroke_width(2)))
+                .draw(&PathElement::new(
+                    [(0, legend_y), (24, legend_y)],
+                    colour.stroke_width(2),
+                ))
                 .map_err(|e| e.to_string())?;
-            legend_area
-                .draw(&Text::new(s.label.clone(), (32, y - 8), ("sans-serif", 14)))
-                .map_err(|e| e.to_string())?;
+            let label_width = legend_area.dim_in_pixel().0 - 40;
+            for line in wrapped(&legend_area, &s.label, label_width)? {
+                legend_area
+                    .draw(&Text::new(line, (32, legend_y - 8), LEGEND_FONT))
+                    .map_err(|e| e.to_string())?;
+                legend_y += 18;
+            }
+            legend_y += 6;
         }
         root.present().map_err(|e| e.to_string())?;
     }
     std::fs::rename(&temporary, path).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_legend_label_wraps_within_the_panel_and_keeps_every_word() {
+        font().unwrap();
+        let mut pixels = vec![0u8; 240 * 100 * 3];
+        let area = BitMapBackend::with_buffer(&mut pixels, (240, 100)).into_drawing_area();
+        let label = "CubeRotEnv (paper mode) (3 seeds, mean and one standard deviation)";
+        let lines = wrapped(&area, label, 200).unwrap();
+        assert!(lines.len() > 1, "{lines:?}");
+        for line in &lines {
+            let (width, _) = area
+                .estimate_text_size(line, &LEGEND_FONT.into_text_style(&area))
+                .unwrap();
+            assert!(width <= 200, "{line:?} is {width} px wide");
+        }
+        assert_eq!(lines.join(" "), label);
+        assert_eq!(wrapped(&area, "U'", 200).unwrap(), ["U'"]);
+    }
 }
