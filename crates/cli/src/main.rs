@@ -33,6 +33,7 @@ enum Command {
     Render(render::RenderArgs),
     Train(train::TrainArgs),
     Plot(train::PlotArgs),
+    Average(train::AverageArgs),
     Eval(eval::EvalArgs),
     EvalStage(eval::EvalStageArgs),
     /// Inspects the training environments.
@@ -60,6 +61,7 @@ fn main() -> ExitCode {
         Command::Env(command) => env::run(command),
         Command::Train(args) => train::run(args),
         Command::Plot(args) => train::plot(args),
+        Command::Average(args) => train::average(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),
         Command::Bench(command) => bench::run(command),

@@ -139,6 +139,38 @@ pub fn plot(args: PlotArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Averages the actor weights of several policies of one run, such as its snapshots, into one
+/// policy (stochastic weight averaging), with their normalisers pooled.
+#[derive(Args)]
+pub struct AverageArgs {
+    /// Policies to average, each as the path of its .safetensors and .json less the extension.
+    #[arg(required = true, num_args = 2..)]
+    policies: Vec<PathBuf>,
+    /// Where to write the average (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn average(args: AverageArgs) -> anyhow::Result<ExitCode> {
+    let members: Vec<String> = args
+        .policies
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let command = format!(
+        "dexcube average {} --out {}",
+        members.join(" "),
+        args.out.display()
+    );
+    dexcube_rl::Policy::average(&args.policies, &args.out, &command)?;
+    println!(
+        "averaged {} policies into {}",
+        members.len(),
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Refuses to resume a run with other recorded starts than it began with (its checkpoint's
 /// card names them), since the card would then say it trained on starts it did not.
 fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {

@@ -647,3 +647,50 @@ fn plot_draws_runs_across_seeds_and_refuses_a_seed_twice() {
     );
     assert_clean_failure(&o, 2, "is not a training run's folder");
 }
+
+#[test]
+fn average_writes_a_policy_eval_stage_runs_and_refuses_members_that_do_not_fit() {
+    let dir = std::env::temp_dir().join("dexcube-cli-average");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("rot-average");
+    let out = out.to_str().unwrap();
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let (rot, layer) = (rot.to_str().unwrap(), layer.to_str().unwrap());
+    let o = dexcube(&["average", rot, rot, "--out", out], "");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{out}.json")).unwrap()).unwrap();
+    assert_eq!(card["metadata"]["environment"]["mode"], "pair");
+    assert!(
+        card["metadata"]["command"]
+            .as_str()
+            .unwrap()
+            .starts_with("dexcube average ")
+    );
+    let o = dexcube(
+        &[
+            "eval-stage",
+            "rot",
+            "--episodes",
+            "2",
+            "--threads",
+            "1",
+            "--rot-policy",
+            out,
+            "--layer-policy",
+            layer,
+        ],
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("pair mode"), "{}", stdout(&o));
+
+    let o = dexcube(&["average", rot, layer, "--out", out], "");
+    assert_clean_failure(&o, 2, "layer.safetensors does not fit");
+    let missing = dir.join("missing");
+    let o = dexcube(
+        &["average", rot, missing.to_str().unwrap(), "--out", out],
+        "",
+    );
+    assert_clean_failure(&o, 2, "missing.json");
+}

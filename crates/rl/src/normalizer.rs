@@ -74,6 +74,26 @@ impl Normalizer {
         }
     }
 
+    /// The statistics of every row that `normalizers` learnt from, taken together: the inputs a
+    /// weight average of their policies will see. `None` if they differ in size or settings.
+    pub fn pooled(normalizers: &[&Normalizer]) -> Option<Normalizer> {
+        let (first, rest) = normalizers.split_first()?;
+        let mut pooled = (*first).clone();
+        for other in rest {
+            let same_settings = (other.eps, other.clip, other.clip_input)
+                == (pooled.eps, pooled.clip, pooled.clip_input);
+            if other.size() != pooled.size() || !same_settings {
+                return None;
+            }
+            for k in 0..pooled.size() {
+                pooled.sum[k] += other.sum[k];
+                pooled.sum_sq[k] += other.sum_sq[k];
+            }
+            pooled.count += other.count;
+        }
+        Some(pooled)
+    }
+
     /// Appends the normalised `row` to `out`.
     pub fn normalize_into(&self, row: &[f64], out: &mut Vec<f32>) {
         for (k, &x) in row.iter().enumerate() {
@@ -99,6 +119,30 @@ mod tests {
         let mut out = vec![];
         n.normalize_into(&[2.0, 1000.0], &mut out);
         assert_eq!(out, [0.0, 5.0]);
+    }
+
+    #[test]
+    fn pooled_statistics_are_those_of_all_the_rows_together() {
+        let mut a = Normalizer::new(1, 0.01, 5.0, 200.0);
+        let mut b = a.clone();
+        let mut both = a.clone();
+        for x in [1.0, 2.0] {
+            a.update(&[x]);
+            both.update(&[x]);
+        }
+        for x in [6.0, 7.0, 9.0] {
+            b.update(&[x]);
+            both.update(&[x]);
+        }
+        let pooled = Normalizer::pooled(&[&a, &b]).unwrap();
+        assert!((pooled.mean(0) - both.mean(0)).abs() < 1e-12);
+        assert!((pooled.std(0) - both.std(0)).abs() < 1e-12);
+        assert_eq!(
+            Normalizer::pooled(&[&a, &a.widened(1)]),
+            None,
+            "sizes differ"
+        );
+        assert_eq!(Normalizer::pooled(&[]), None);
     }
 
     #[test]

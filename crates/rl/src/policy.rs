@@ -12,7 +12,7 @@ use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
 use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
-use crate::params;
+use crate::params::{self, NamedTensor};
 
 /// Everything about a policy but its weights.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -61,6 +61,77 @@ impl Policy {
             checkpoint::save_json(&card_path, &card)?;
         }
         Ok(())
+    }
+
+    /// Writes at `out` the weight average of the policies at `members` (stochastic weight
+    /// averaging over one run's snapshots): each actor weight is the mean of the members',
+    /// and the normalisers pool the members' statistics. The members must share the network
+    /// and the environment's sizes. The card keeps the first member's configuration, label and
+    /// environment, and records the members and `command`, the command that averaged them.
+    pub fn average(members: &[PathBuf], out: &Path, command: &str) -> Result<(), CheckpointError> {
+        let Some(first) = members.first() else {
+            return Err(CheckpointError::Mismatch {
+                path: out.to_path_buf(),
+                message: "no policies to average".to_string(),
+            });
+        };
+        let mut cards = Vec::new();
+        let mut sum: Vec<NamedTensor> = Vec::new();
+        for member in members {
+            let (weights, card_path) = policy_paths(member);
+            let card: PolicyCard = checkpoint::load_json(&card_path)?;
+            let mut tensors = checkpoint::load_tensors(&weights)?;
+            tensors.sort_by(|a, b| a.name.cmp(&b.name));
+            let mismatch = |what: &str| CheckpointError::Mismatch {
+                path: weights.clone(),
+                message: format!("{what} than {}", first.display()),
+            };
+            if let Some(head) = cards.first() {
+                let head: &PolicyCard = head;
+                let same_sizes =
+                    (card.dims, &card.config.hidden) == (head.dims, &head.config.hidden);
+                if !same_sizes || tensors.len() != sum.len() {
+                    return Err(mismatch("other network sizes"));
+                }
+                for (total, tensor) in sum.iter_mut().zip(&tensors) {
+                    if (&total.name, &total.shape) != (&tensor.name, &tensor.shape) {
+                        return Err(mismatch("other tensor names or shapes"));
+                    }
+                    for (t, v) in total.values.iter_mut().zip(&tensor.values) {
+                        *t += v;
+                    }
+                }
+            } else {
+                sum = tensors;
+            }
+            cards.push(card);
+        }
+        let scale = 1.0 / members.len() as f32;
+        for tensor in &mut sum {
+            tensor.values.iter_mut().for_each(|v| *v *= scale);
+        }
+        let pooled = |pick: fn(&PolicyCard) -> &Normalizer| {
+            let members: Vec<&Normalizer> = cards.iter().map(pick).collect();
+            Normalizer::pooled(&members).ok_or_else(|| CheckpointError::Mismatch {
+                path: out.to_path_buf(),
+                message: "the members' normalisers differ in size or settings".to_string(),
+            })
+        };
+        let head = &cards[0].metadata;
+        let card = PolicyCard {
+            observation_norm: pooled(|c| &c.observation_norm)?,
+            goal_norm: pooled(|c| &c.goal_norm)?,
+            metadata: serde_json::json!({
+                "label": head["label"],
+                "environment": head["environment"],
+                "averaged": members,
+                "command": command,
+            }),
+            ..cards[0].clone()
+        };
+        let (weights, card_path) = policy_paths(out);
+        checkpoint::save_tensors(&weights, &sum)?;
+        checkpoint::save_json(&card_path, &card)
     }
 
     /// Loads the policy at `prefix` onto `device`.

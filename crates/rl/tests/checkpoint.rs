@@ -507,3 +507,62 @@ fn corrupt_and_mismatched_files_are_clear_errors() {
         .to_string();
     assert!(err.contains("nothing.json"), "{err}");
 }
+
+#[test]
+fn a_weight_average_of_snapshots_holds_their_mean_weights_and_pooled_normalisers() {
+    let dir = fresh_dir("dexcube-rl-average");
+    train(PointMassEnv::default, config(), &options(&dir, 4, false)).unwrap();
+    let members = [
+        dir.join("snapshots/epoch-0001"),
+        dir.join("snapshots/epoch-0003"),
+    ];
+    let out = dir.join("average");
+    Policy::average(&members, &out, "dexcube average ...").unwrap();
+    let weights = |prefix: &std::path::Path| {
+        by_name(
+            dexcube_rl::checkpoint::load_tensors(&prefix.with_extension("safetensors")).unwrap(),
+        )
+    };
+    let (early, late, mean) = (weights(&members[0]), weights(&members[1]), weights(&out));
+    assert_ne!(
+        early, late,
+        "the snapshots differ, so the mean is not one of them"
+    );
+    assert_eq!(mean.len(), early.len());
+    for ((e, l), m) in early.iter().zip(&late).zip(&mean) {
+        assert_eq!((&m.name, &m.shape), (&e.name, &e.shape));
+        for ((e, l), m) in e.values.iter().zip(&l.values).zip(&m.values) {
+            assert!((m - (e + l) / 2.0).abs() < 1e-6, "{}: {m} vs {e}, {l}", e);
+        }
+    }
+    let device = burn::prelude::Device::flex();
+    let [first, second] = members
+        .each_ref()
+        .map(|p| Policy::load(p, &device).unwrap());
+    let average = Policy::load(&out, &device).unwrap();
+    let pooled = dexcube_rl::normalizer::Normalizer::pooled(&[
+        &first.card.observation_norm,
+        &second.card.observation_norm,
+    ]);
+    assert_eq!(Some(average.card.observation_norm.clone()), pooled);
+    let metadata = &average.card.metadata;
+    assert_eq!(metadata["environment"], first.card.metadata["environment"]);
+    assert_eq!(metadata["averaged"][1], members[1].display().to_string());
+    assert_eq!(metadata["command"], "dexcube average ...");
+
+    // A policy of another network is refused, by name.
+    let small = fresh_dir("dexcube-rl-average-small");
+    let other = DdpgHerConfig {
+        hidden: vec![8],
+        ..config()
+    };
+    train(PointMassEnv::default, other, &options(&small, 1, false)).unwrap();
+    let err = Policy::average(&[members[0].clone(), small.join("policy")], &out, "")
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("other network sizes") && err.contains("policy.safetensors"),
+        "{err}"
+    );
+}
