@@ -927,11 +927,12 @@ fn record(
         "successes_left_square": square_successes,
         "seed": args.seed,
         "command": format!(
-            "dexcube eval-stage {} --object {} --episodes {} --seed {}",
-            args.stage.name(),
+            "dexcube eval-stage {stage} --object {} --episodes {} --seed {} --{stage}-policy {}",
             object.name(),
             args.episodes,
-            args.seed
+            args.seed,
+            prefix.display(),
+            stage = args.stage.name(),
         ),
     });
     write_atomically(&path, serde_json::to_string_pretty(&card)?.as_bytes())?;

@@ -539,11 +539,10 @@ fn eval_stage_records_each_object_under_its_own_name() {
     // The shipped Stage 2 was trained on the physical cube: the block is the other object.
     assert_eq!(metadata["environment"]["object"], "cube");
     assert_eq!(metadata["evaluation"]["episodes"], 2);
+    let command = metadata["evaluation"]["command"].as_str().unwrap();
     assert!(
-        metadata["evaluation"]["command"]
-            .as_str()
-            .unwrap()
-            .contains("--object cube")
+        command.contains("--object cube") && command.ends_with(&format!("--layer-policy {layer}")),
+        "{command}"
     );
     assert!(
         metadata["evaluation_on_block"]["command"]
