@@ -118,6 +118,7 @@ pub fn line_plot(
             .map_err(|e| e.to_string())?;
         let drawn = series.iter().filter(|s| !s.points.is_empty());
         let mut legend_y = 60;
+        let label_width = legend_area.dim_in_pixel().0 - 40;
         for (i, s) in drawn.enumerate() {
             let colour = TAB10[i % TAB10.len()].to_rgba();
             if let Some(band) = &s.band {
@@ -137,7 +138,6 @@ pub fn line_plot(
                     colour.stroke_width(2),
                 ))
                 .map_err(|e| e.to_string())?;
-            let label_width = legend_area.dim_in_pixel().0 - 40;
             for line in wrapped(&legend_area, &s.label, label_width)? {
                 legend_area
                     .draw(&Text::new(line, (32, legend_y - 8), LEGEND_FONT))

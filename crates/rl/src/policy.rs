@@ -69,49 +69,50 @@ impl Policy {
     /// and the environment's sizes. The card keeps the first member's configuration, label and
     /// environment, and records the members and `command`, the command that averaged them.
     pub fn average(members: &[PathBuf], out: &Path, command: &str) -> Result<(), CheckpointError> {
-        let Some(first) = members.first() else {
-            return Err(CheckpointError::Mismatch {
-                path: out.to_path_buf(),
-                message: "no policies to average".to_string(),
-            });
-        };
-        let mut cards = Vec::new();
-        let mut sum: Vec<NamedTensor> = Vec::new();
+        let mut loaded = Vec::with_capacity(members.len());
         for member in members {
             let (weights, card_path) = policy_paths(member);
             let card: PolicyCard = checkpoint::load_json(&card_path)?;
             let mut tensors = checkpoint::load_tensors(&weights)?;
             tensors.sort_by(|a, b| a.name.cmp(&b.name));
-            let mismatch = |what: &str| CheckpointError::Mismatch {
-                path: weights.clone(),
-                message: format!("{what} than {}", first.display()),
-            };
-            if let Some(head) = cards.first() {
-                let head: &PolicyCard = head;
-                let same_sizes =
-                    (card.dims, &card.config.hidden) == (head.dims, &head.config.hidden);
-                if !same_sizes || tensors.len() != sum.len() {
-                    return Err(mismatch("other network sizes"));
-                }
-                for (total, tensor) in sum.iter_mut().zip(&tensors) {
-                    if (&total.name, &total.shape) != (&tensor.name, &tensor.shape) {
-                        return Err(mismatch("other tensor names or shapes"));
-                    }
-                    for (t, v) in total.values.iter_mut().zip(&tensor.values) {
-                        *t += v;
-                    }
-                }
-            } else {
-                sum = tensors;
+            loaded.push((weights, card, tensors));
+        }
+        let Some(((_, _, first), rest)) = loaded.split_first() else {
+            return Err(CheckpointError::Mismatch {
+                path: out.to_path_buf(),
+                message: "no policies to average".to_string(),
+            });
+        };
+        // The tensors' names and shapes are the network's sizes; the normalisers, pooled
+        // below, check the environment's.
+        fn layout(tensors: &[NamedTensor]) -> Vec<(&str, &[usize])> {
+            tensors
+                .iter()
+                .map(|t| (t.name.as_str(), t.shape.as_slice()))
+                .collect()
+        }
+        let first_layout = layout(first);
+        let mut mean = first.clone();
+        for (weights, _, tensors) in rest {
+            if layout(tensors) != first_layout {
+                return Err(CheckpointError::Mismatch {
+                    path: weights.clone(),
+                    message: format!("other network sizes than {}", members[0].display()),
+                });
             }
-            cards.push(card);
+            for (total, tensor) in mean.iter_mut().zip(tensors) {
+                for (t, v) in total.values.iter_mut().zip(&tensor.values) {
+                    *t += v;
+                }
+            }
         }
         let scale = 1.0 / members.len() as f32;
-        for tensor in &mut sum {
+        for tensor in &mut mean {
             tensor.values.iter_mut().for_each(|v| *v *= scale);
         }
+        let cards: Vec<&PolicyCard> = loaded.iter().map(|(_, card, _)| card).collect();
         let pooled = |pick: fn(&PolicyCard) -> &Normalizer| {
-            let members: Vec<&Normalizer> = cards.iter().map(pick).collect();
+            let members: Vec<&Normalizer> = cards.iter().map(|c| pick(c)).collect();
             Normalizer::pooled(&members).ok_or_else(|| CheckpointError::Mismatch {
                 path: out.to_path_buf(),
                 message: "the members' normalisers differ in size or settings".to_string(),
@@ -130,7 +131,7 @@ impl Policy {
             ..cards[0].clone()
         };
         let (weights, card_path) = policy_paths(out);
-        checkpoint::save_tensors(&weights, &sum)?;
+        checkpoint::save_tensors(&weights, &mean)?;
         checkpoint::save_json(&card_path, &card)
     }
 

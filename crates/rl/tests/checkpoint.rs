@@ -55,6 +55,17 @@ fn fresh_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
+/// A one-epoch point-mass run of a smaller network (one hidden layer of 8), in a fresh folder.
+fn small_network_run(name: &str) -> std::path::PathBuf {
+    let dir = fresh_dir(name);
+    let small = DdpgHerConfig {
+        hidden: vec![8],
+        ..config()
+    };
+    train(PointMassEnv::default, small, &options(&dir, 1, false)).unwrap();
+    dir
+}
+
 #[test]
 fn a_run_writes_its_files_and_resumes_where_it_stopped() {
     let dir = fresh_dir("dexcube-rl-resume");
@@ -486,12 +497,7 @@ fn corrupt_and_mismatched_files_are_clear_errors() {
         "{err}"
     );
     // Weights of another network under this card.
-    let small = fresh_dir("dexcube-rl-small");
-    let other = DdpgHerConfig {
-        hidden: vec![8],
-        ..config()
-    };
-    train(PointMassEnv::default, other, &options(&small, 1, false)).unwrap();
+    let small = small_network_run("dexcube-rl-small");
     std::fs::copy(small.join("policy.safetensors"), &weights).unwrap();
     let err = Policy::load(&dir.join("policy"), &device)
         .err()
@@ -551,12 +557,7 @@ fn a_weight_average_of_snapshots_holds_their_mean_weights_and_pooled_normalisers
     assert_eq!(metadata["command"], "dexcube average ...");
 
     // A policy of another network is refused, by name.
-    let small = fresh_dir("dexcube-rl-average-small");
-    let other = DdpgHerConfig {
-        hidden: vec![8],
-        ..config()
-    };
-    train(PointMassEnv::default, other, &options(&small, 1, false)).unwrap();
+    let small = small_network_run("dexcube-rl-average-small");
     let err = Policy::average(&[members[0].clone(), small.join("policy")], &out, "")
         .err()
         .unwrap()
