@@ -77,7 +77,7 @@ impl Policy {
             tensors.sort_by(|a, b| a.name.cmp(&b.name));
             loaded.push((weights, card, tensors));
         }
-        let Some(((_, _, first), rest)) = loaded.split_first() else {
+        let Some(((_, first_card, first), rest)) = loaded.split_first() else {
             return Err(CheckpointError::Mismatch {
                 path: out.to_path_buf(),
                 message: "no policies to average".to_string(),
@@ -110,15 +110,14 @@ impl Policy {
         for tensor in &mut mean {
             tensor.values.iter_mut().for_each(|v| *v *= scale);
         }
-        let cards: Vec<&PolicyCard> = loaded.iter().map(|(_, card, _)| card).collect();
         let pooled = |pick: fn(&PolicyCard) -> &Normalizer| {
-            let members: Vec<&Normalizer> = cards.iter().map(|c| pick(c)).collect();
+            let members: Vec<&Normalizer> = loaded.iter().map(|(_, card, _)| pick(card)).collect();
             Normalizer::pooled(&members).ok_or_else(|| CheckpointError::Mismatch {
                 path: out.to_path_buf(),
                 message: "the members' normalisers differ in size or settings".to_string(),
             })
         };
-        let head = &cards[0].metadata;
+        let head = &first_card.metadata;
         let card = PolicyCard {
             observation_norm: pooled(|c| &c.observation_norm)?,
             goal_norm: pooled(|c| &c.goal_norm)?,
@@ -128,7 +127,7 @@ impl Policy {
                 "averaged": members,
                 "command": command,
             }),
-            ..cards[0].clone()
+            ..first_card.clone()
         };
         let (weights, card_path) = policy_paths(out);
         checkpoint::save_tensors(&weights, &mean)?;
