@@ -125,6 +125,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         watch: &mut watch,
         narrate: &mut narrate,
         stage1_starts: None,
+        stage2_starts: None,
     };
     let job = (
         scramble.moves.as_slice(),

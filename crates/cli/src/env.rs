@@ -272,15 +272,29 @@ fn policy_name(policy: PolicyArg) -> &'static str {
     }
 }
 
-/// Loads recorded Stage 1 starts for `scene`, refusing a file of another scene or another
-/// state size with a message that says so.
+/// Loads recorded starts of `stage` for `scene`, refusing a file of another stage, another
+/// scene or another state size with a message that says so.
 pub fn starts_for(
     path: &std::path::Path,
     scene: &std::sync::Arc<Scene>,
+    stage: EnvKind,
 ) -> anyhow::Result<std::sync::Arc<[dexcube_env::RecordedStart]>> {
     let (starts, origin) = dexcube_rl::start_file::load_starts(path)?;
     if starts.is_empty() {
         bail!("{} holds no starts", path.display());
+    }
+    if origin.stage != stage.name() {
+        bail!(
+            "{} holds {} starts, not {}'s: record {} with `dexcube eval {}`",
+            path.display(),
+            origin.stage,
+            stage.name(),
+            stage.name(),
+            match stage {
+                EnvKind::Rot => "--record-starts FILE",
+                EnvKind::Layer => "--record-layer-starts FILE",
+            }
+        );
     }
     let name = scene.kind().name();
     if origin.scene != name {

@@ -324,6 +324,11 @@ pub struct EvalArgs {
     /// `eval-stage rot --starts`. Needs a fresh --out.
     #[arg(long, value_name = "FILE")]
     record_starts: Option<PathBuf>,
+    /// Also record where every Stage 2 run began (the physics state once the hand has
+    /// opened) into this file, for `train layer --starts` and `eval-stage layer --starts`.
+    /// Needs a fresh --out.
+    #[arg(long, value_name = "FILE")]
+    record_layer_starts: Option<PathBuf>,
 }
 
 fn parse_distances(text: &str) -> anyhow::Result<Vec<usize>> {
@@ -406,9 +411,13 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
             files.layer.display()
         )
     };
-    if args.record_starts.is_some() && !results.is_empty() {
+    let recording = [
+        (EnvKind::Rot, &args.record_starts),
+        (EnvKind::Layer, &args.record_layer_starts),
+    ];
+    if recording.iter().any(|(_, path)| path.is_some()) && !results.is_empty() {
         bail!(
-            "--record-starts records every cube of a run, and {} already holds {} of them: pass a new --out",
+            "recording starts records every cube of a run, and {} already holds {} of them: pass a new --out",
             csv.display(),
             results.len()
         );
@@ -451,15 +460,16 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         |stages, k| {
             let (d, i, rollback, moves) = &jobs[k];
             let seed = args.seed ^ ((*d as u64) << 40) ^ ((*i as u64) << 8) ^ (*rollback as u64);
-            let mut starts = Vec::new();
+            let (mut starts1, mut starts2) = (Vec::new(), Vec::new());
             let hooks = Hooks {
                 watch: &mut |_| {},
                 narrate: &mut |_| {},
-                stage1_starts: args.record_starts.is_some().then_some(&mut starts),
+                stage1_starts: args.record_starts.is_some().then_some(&mut starts1),
+                stage2_starts: args.record_layer_starts.is_some().then_some(&mut starts2),
             };
             let job = (moves.as_slice(), args.operator.config(*rollback), seed);
             let outcome = run_cube(stages, &scene, planner, job, hooks);
-            recorded.lock().expect("lock").push((k, starts));
+            recorded.lock().expect("lock").push((k, [starts1, starts2]));
             let row = CubeResult {
                 distance: *d,
                 index: *i,
@@ -486,25 +496,44 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     done?;
     let results = shared.into_inner().expect("lock");
     save(&results)?;
-    if let Some(path) = &args.record_starts {
-        let mut recorded = recorded.into_inner().expect("lock");
-        recorded.sort_by_key(|(k, _)| *k);
-        let starts: Vec<_> = recorded.into_iter().flat_map(|(_, s)| s).collect();
+    let mut recorded = recorded.into_inner().expect("lock");
+    recorded.sort_by_key(|(k, _)| *k);
+    let record_flags: String = [
+        ("--record-starts", &args.record_starts),
+        ("--record-layer-starts", &args.record_layer_starts),
+    ]
+    .iter()
+    .filter_map(|(flag, path)| path.as_ref().map(|p| format!(" {flag} {}", p.display())))
+    .collect();
+    for (stage_index, (stage, path)) in recording.into_iter().enumerate() {
+        let Some(path) = path else { continue };
+        let starts: Vec<_> = recorded
+            .iter_mut()
+            .flat_map(|(_, s)| std::mem::take(&mut s[stage_index]))
+            .collect();
+        let (name, failure) = match stage {
+            EnvKind::Rot => ("Stage 1", "dropped the cube"),
+            EnvKind::Layer => (
+                "Stage 2",
+                "did not leave the layer turned with the cube square",
+            ),
+        };
         if starts.is_empty() {
             bail!(
-                "no Stage 1 run began with the hand open in these cubes, so {} was not written: \
+                "no {name} run began with the hand open in these cubes, so {} was not written: \
                  record over more cubes or longer move distances",
                 path.display()
             );
         }
         let origin = StartsOrigin {
+            stage: stage.name().to_string(),
             scene: SceneKind::Cube.name().to_string(),
-            command: format!("{} --record-starts {}", command(&results), path.display()),
+            command: format!("{}{record_flags}", command(&results)),
         };
         save_starts(path, &starts, &origin)?;
-        let dropped = starts.iter().filter(|s| s.dropped).count();
+        let failed = starts.iter().filter(|s| s.failed).count();
         eprintln!(
-            "recorded {} Stage 1 starts ({dropped} of which the policy dropped the cube from) in {}",
+            "recorded {} {name} starts (from {failed} of which the policy {failure}) in {}",
             starts.len(),
             path.display()
         );
@@ -617,9 +646,10 @@ pub struct EvalStageArgs {
     /// Also write the result into the policy's JSON card, as its evaluation.
     #[arg(long, conflicts_with = "starts")]
     record: bool,
-    /// rot only: begin episode k from recorded start k of this file (made by `eval
-    /// --record-starts`), where the operator handed Stage 1 the cube, rather than from a
-    /// fresh placement seeded seed + k. Runs the first min(--episodes, starts) of them.
+    /// Begin episode k from recorded start k of this file, where the operator handed the
+    /// stage the cube (made by `eval --record-starts` for rot, `eval --record-layer-starts`
+    /// for layer), rather than from a fresh placement seeded seed + k. Runs the first
+    /// min(--episodes, starts) of them.
     #[arg(long, value_name = "FILE")]
     starts: Option<PathBuf>,
 }
@@ -763,19 +793,24 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         None => trained,
     };
     let scene = Scene::load(object.scene())?;
-    let starts = match (&args.starts, args.stage) {
-        (None, _) => None,
-        (Some(path), EnvKind::Rot) => Some(starts_for(path, &scene)?),
-        (Some(_), EnvKind::Layer) => bail!("--starts are Stage 1's: use them with eval-stage rot"),
+    let starts = match &args.starts {
+        None => None,
+        Some(path) => Some(starts_for(path, &scene, args.stage)?),
+    };
+    let numbered = |starts: &Option<std::sync::Arc<[dexcube_env::RecordedStart]>>| {
+        starts.as_ref().map(|starts| StartMix {
+            starts: starts.clone(),
+            pick: StartPick::Numbered,
+        })
     };
     let episodes = starts
         .as_ref()
         .map_or(args.episodes, |s| args.episodes.min(s.len()));
-    // Starts from which the recorded policy dropped the cube, and this one did too.
-    let recorded_drops = starts.as_ref().map_or(0, |s| {
-        s[..episodes].iter().filter(|start| start.dropped).count()
+    // Starts from which the recorded policy failed, and this one did too.
+    let recorded_failures = starts.as_ref().map_or(0, |s| {
+        s[..episodes].iter().filter(|start| start.failed).count()
     });
-    let drops_again = AtomicUsize::new(0);
+    let failures_again = AtomicUsize::new(0);
     let bar = ProgressBar::new(episodes as u64);
     in_parallel(
         args.threads,
@@ -786,22 +821,23 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 EnvKind::Rot => {
                     let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
                     let env = CubeRotEnv::with_scene(scene.clone(), goal);
-                    Box::new(match &starts {
-                        Some(starts) => env.with_starts(StartMix {
-                            starts: starts.clone(),
-                            pick: StartPick::Numbered,
-                        }),
+                    Box::new(match numbered(&starts) {
+                        Some(mix) => env.with_starts(mix),
                         None => env,
                     })
                 }
-                EnvKind::Layer => Box::new(
-                    LayerOpEnv::with_scene(
+                EnvKind::Layer => {
+                    let env = LayerOpEnv::with_scene(
                         scene.clone(),
                         LayerMove::UPrime,
                         LayerGoals::Evaluation,
                     )
-                    .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?),
-                ),
+                    .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?);
+                    Box::new(match numbered(&starts) {
+                        Some(mix) => env.with_starts(mix),
+                        None => env,
+                    })
+                }
             };
             Ok((policy, env))
         },
@@ -814,8 +850,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);
-            if ending == Ending::Dropped && starts.as_ref().is_some_and(|s| s[k].dropped) {
-                drops_again.fetch_add(1, Ordering::Relaxed);
+            // What the recording counted as failing: Stage 1, a drop; Stage 2, anything but
+            // the quarter turn left square.
+            let failed = match args.stage {
+                EnvKind::Rot => ending == Ending::Dropped,
+                EnvKind::Layer => ending != Ending::Success || !trace.square,
+            };
+            if failed && starts.as_ref().is_some_and(|s| s[k].failed) {
+                failures_again.fetch_add(1, Ordering::Relaxed);
             }
             if ending == Ending::Success && !trace.square {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
@@ -875,9 +917,13 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if starts.is_some() {
+        let failure = match args.stage {
+            EnvKind::Rot => "dropped the cube",
+            EnvKind::Layer => "did not leave the layer turned with the cube square",
+        };
         println!(
-            "  starts from which the recorded policy dropped the cube: {recorded_drops}; this one dropped it from {} of them",
-            drops_again.into_inner()
+            "  starts from which the recorded policy {failure}: {recorded_failures}; this one failed so from {} of them",
+            failures_again.into_inner()
         );
     }
     if args.record {

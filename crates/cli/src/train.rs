@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use clap::Args;
-use dexcube_env::layer::LayerGoals;
+use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{CubeRotEnv, LayerOpEnv, StartMix, StartPick};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
 use dexcube_sim::Scene;
@@ -86,18 +86,26 @@ pub struct TrainArgs {
     /// Train without Hindsight Experience Replay (plain DDPG), for ablations.
     #[arg(long)]
     no_her: bool,
-    /// rot on the physical cube: begin a share of episodes (--start-share) from the Stage 1
-    /// starts recorded in this file (`dexcube eval --record-starts`), where the operator hands
-    /// the cube over, rather than from a fresh placement. A resume must name the same.
+    /// On the physical cube: begin a share of episodes (--start-share) from the starts
+    /// recorded in this file, where the operator hands the cube over, rather than from a fresh
+    /// placement: Stage 1's (`dexcube eval --record-starts`) for rot, Stage 2's (`dexcube eval
+    /// --record-layer-starts`) for layer U'. A resume must name the same.
     #[arg(long, value_name = "FILE")]
     starts: Option<PathBuf>,
     /// With --starts, the probability that an episode begins from one of them.
     #[arg(long, default_value_t = 0.5, value_name = "P", requires = "starts")]
     start_share: f64,
-    /// With --starts, how many times as often a start the recorded policy dropped the cube
-    /// from is drawn as one it kept the cube from (1: all alike).
-    #[arg(long, default_value_t = 1.0, value_name = "W", requires = "starts")]
-    dropped_weight: f64,
+    /// With --starts, how many times as often a start the recorded policy failed from (Stage
+    /// 1: dropped the cube; Stage 2: did not leave the layer turned with the cube square) is
+    /// drawn as one it succeeded from (1: all alike).
+    #[arg(
+        long,
+        alias = "dropped-weight",
+        default_value_t = 1.0,
+        value_name = "W",
+        requires = "starts"
+    )]
+    failed_weight: f64,
 }
 
 /// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
@@ -180,7 +188,7 @@ fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Resu
     };
     let flags = |starts: Option<String>, share: Option<f64>, weight: f64| match (starts, share) {
         (Some(starts), Some(share)) => {
-            format!("--starts {starts} --start-share {share} --dropped-weight {weight}")
+            format!("--starts {starts} --start-share {share} --failed-weight {weight}")
         }
         _ => "no --starts".to_string(),
     };
@@ -188,13 +196,17 @@ fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Resu
     let begun = flags(
         environment["starts"].as_str().map(str::to_string),
         environment["start_share"].as_f64(),
-        // Runs from before the weight drew every start alike.
-        environment["dropped_weight"].as_f64().unwrap_or(1.0),
+        // Runs from before the weight drew every start alike; sessions 17 and 18 named it
+        // after Stage 1's failures, drops.
+        environment["failed_weight"]
+            .as_f64()
+            .or(environment["dropped_weight"].as_f64())
+            .unwrap_or(1.0),
     );
     let now = flags(
         args.starts.as_ref().map(|p| p.display().to_string()),
         Some(args.start_share),
-        args.dropped_weight,
+        args.failed_weight,
     );
     if begun != now {
         bail!(
@@ -219,8 +231,13 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     }
     let object = args.choice.object()?;
     let square = args.choice.square()?;
-    if args.starts.is_some() && matches!(args.choice.env, EnvKind::Layer) {
-        bail!("--starts are Stage 1's: use them with train rot --object cube");
+    if args.starts.is_some()
+        && matches!(args.choice.env, EnvKind::Layer)
+        && args.choice.layer_move != LayerMove::UPrime
+    {
+        bail!(
+            "--starts for layer are the operator's Stage 2 starts: train them with --move \"U'\""
+        );
     }
     if !(0.0..=1.0).contains(&args.start_share) {
         bail!(
@@ -228,10 +245,10 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             args.start_share
         );
     }
-    if !(args.dropped_weight.is_finite() && args.dropped_weight > 0.0) {
+    if !(args.failed_weight.is_finite() && args.failed_weight > 0.0) {
         bail!(
-            "--dropped-weight must be a positive number, not {}",
-            args.dropped_weight
+            "--failed-weight must be a positive number, not {}",
+            args.failed_weight
         );
     }
     let suffix = args
@@ -320,7 +337,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "init_actor": args.init_actor.as_ref().map(|p| p.display().to_string()),
             "starts": args.starts.as_ref().map(|p| p.display().to_string()),
             "start_share": args.starts.as_ref().map(|_| args.start_share),
-            "dropped_weight": args.starts.as_ref().map(|_| args.dropped_weight),
+            "failed_weight": args.starts.as_ref().map(|_| args.failed_weight),
         }),
     };
     eprintln!(
@@ -330,19 +347,19 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         seed
     );
     let scene = Scene::load(object.scene())?;
+    let starts = match &args.starts {
+        Some(path) => Some(StartMix {
+            starts: starts_for(path, &scene, args.choice.env)?,
+            pick: StartPick::Share {
+                share: args.start_share,
+                failed_weight: args.failed_weight,
+            },
+        }),
+        None => None,
+    };
     let trained = match args.choice.env {
         EnvKind::Rot => {
             let goal = args.choice.rot_goal()?;
-            let starts = match &args.starts {
-                Some(path) => Some(StartMix {
-                    starts: starts_for(path, &scene)?,
-                    pick: StartPick::Share {
-                        share: args.start_share,
-                        dropped_weight: args.dropped_weight,
-                    },
-                }),
-                None => None,
-            };
             let make = || {
                 let env = CubeRotEnv::with_scene(scene.clone(), goal);
                 match &starts {
@@ -359,11 +376,14 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             } else {
                 LayerGoals::Training
             };
-            train(
-                || LayerOpEnv::with_scene(scene.clone(), layer_move, goals).with_goal(goal),
-                config,
-                &options,
-            )?
+            let make = || {
+                let env = LayerOpEnv::with_scene(scene.clone(), layer_move, goals).with_goal(goal);
+                match &starts {
+                    Some(mix) => env.with_starts(mix.clone()),
+                    None => env,
+                }
+            };
+            train(make, config, &options)?
         }
     };
     let best = trained

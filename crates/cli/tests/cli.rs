@@ -241,13 +241,15 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     assert!(md.contains("--seed 5 --rot-policy"), "{md}");
 }
 
-/// `eval --record-starts` keeps where each Stage 1 run began, and `eval-stage rot --starts`
-/// runs the policy from them; a file that holds no starts, or starts for Stage 2, is refused.
+/// `eval --record-starts` keeps where each Stage 1 run began, `--record-layer-starts` where
+/// each Stage 2 run began, and `eval-stage rot|layer --starts` runs the policy from them; a
+/// file that holds no starts, or another stage's, is refused.
 #[test]
-fn eval_records_stage_1_starts_that_eval_stage_runs_from() {
+fn eval_records_stage_starts_that_eval_stage_runs_from() {
     let dir = std::env::temp_dir().join("dexcube-cli-starts");
     let _ = std::fs::remove_dir_all(&dir);
     let starts = dir.join("starts.safetensors");
+    let layer_starts = dir.join("layer-starts.safetensors");
     let (rot, layer) = (models().join("rot"), models().join("layer"));
     let policies = [
         "--rot-policy",
@@ -270,6 +272,8 @@ fn eval_records_stage_1_starts_that_eval_stage_runs_from() {
                 dir.join("table").to_str().unwrap(),
                 "--record-starts",
                 starts.to_str().unwrap(),
+                "--record-layer-starts",
+                layer_starts.to_str().unwrap(),
             ][..],
             &policies,
         ]
@@ -288,6 +292,14 @@ fn eval_records_stage_1_starts_that_eval_stage_runs_from() {
     assert!(runs > 0, "{csv}");
     assert!(
         stderr(&o).contains(&format!("recorded {runs} Stage 1 starts")),
+        "{}",
+        stderr(&o)
+    );
+    // A solved cube's Stage 2 runs all kept it past the opening.
+    assert_eq!(row[3], "true", "{csv}");
+    let turns = row[11].parse::<usize>().unwrap();
+    assert!(
+        stderr(&o).contains(&format!("recorded {turns} Stage 2 starts")),
         "{}",
         stderr(&o)
     );
@@ -318,7 +330,17 @@ fn eval_records_stage_1_starts_that_eval_stage_runs_from() {
         "{said}"
     );
     assert!(said.contains("starts from which the recorded policy dropped the cube"));
-    assert_clean_failure(&from(&starts, "layer"), 2, "--starts are Stage 1's");
+    let o = from(&layer_starts, "layer");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = stdout(&o);
+    assert!(said.contains(&format!("/{turns} = ")), "{said}");
+    assert!(said.contains("did not leave the layer turned with the cube square"));
+    assert_clean_failure(&from(&starts, "layer"), 2, "holds rot starts, not layer's");
+    assert_clean_failure(
+        &from(&layer_starts, "rot"),
+        2,
+        "holds layer starts, not rot's",
+    );
     let policy = models().join("rot.safetensors");
     assert_clean_failure(&from(&policy, "rot"), 2, "not a file of recorded starts");
 }
@@ -415,7 +437,10 @@ fn train_refuses_settings_it_cannot_run() {
         (&["rot", "--actor-lr", "0"], "--actor-lr must be a positive"),
         (&["rot", "--anchor=-1"], "--anchor must be 0 or more"),
         (&["rot", "--anchor", "10"], "pass --init or --init-actor"),
-        (&["layer", "--starts", "s"], "--starts are Stage 1's"),
+        (
+            &["layer", "--move", "U", "--starts", "s"],
+            "train them with --move \"U'\"",
+        ),
         (&["rot", "--start-share", "0.2"], "--starts <FILE>"),
         (
             &["rot", "--starts", "s", "--start-share", "2"],
@@ -423,9 +448,9 @@ fn train_refuses_settings_it_cannot_run() {
         ),
         (
             &["rot", "--starts", "s", "--dropped-weight", "0"],
-            "--dropped-weight must be a positive number",
+            "--failed-weight must be a positive number",
         ),
-        (&["rot", "--dropped-weight", "5"], "--starts <FILE>"),
+        (&["rot", "--failed-weight", "5"], "--starts <FILE>"),
         (
             &["rot", "--object", "cube", "--starts", "/no/such/starts"],
             "record starts with `dexcube eval",
@@ -451,7 +476,9 @@ fn train_refuses_settings_it_cannot_run() {
 
 /// A run resumes only with the recorded starts it began with, and drawn as they were, so
 /// that its card never names starts it did not train on: session 12's run began with none,
-/// and session 13's with starts all drawn alike (a card from before `--dropped-weight`).
+/// session 13's with starts all drawn alike (a card from before the weight), and session
+/// 17's with failed starts drawn 20 times as often (a card that names the weight by Stage 1's
+/// failures, `dropped_weight`).
 #[test]
 fn train_resumes_only_with_the_starts_it_began_with() {
     let resume = |committed_run: &str, starts: &[&str]| {
@@ -484,9 +511,17 @@ fn train_resumes_only_with_the_starts_it_began_with() {
         ),
         2,
         &format!(
-            "began with --starts {recorded} --start-share 0.5 --dropped-weight 1; resume it \
-             with the same, not --starts {recorded} --start-share 0.5 --dropped-weight 5"
+            "began with --starts {recorded} --start-share 0.5 --failed-weight 1; resume it \
+             with the same, not --starts {recorded} --start-share 0.5 --failed-weight 5"
         ),
+    );
+    assert_clean_failure(
+        &resume(
+            "rot-pair-cube-square-dropw20-seed0",
+            &["--starts", recorded, "--failed-weight", "5"],
+        ),
+        2,
+        "--start-share 0.5 --failed-weight 20; resume it",
     );
 }
 

@@ -39,6 +39,7 @@ use rand::Rng;
 
 use crate::goal::{Goal, LayerGoal, wrap_angle};
 use crate::hand_object::{BASE_OBSERVATION, HandObject, ObjectKind, canonical};
+use crate::starts::{RecordedStart, StartMix};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// Which layer faces where, and which way it turns.
@@ -135,6 +136,13 @@ impl CubeLayer {
         })
     }
 
+    /// The same count, as if the layer had already turned by `turned` (a recorded start
+    /// resumes the count where the operator's view had it).
+    pub fn counted_from(mut self, turned: f64) -> CubeLayer {
+        self.turned = turned;
+        self
+    }
+
     /// The 62 observations (the layer angle turned so far last).
     pub fn observe(&mut self, sim: &Sim) -> Vec<f64> {
         self.observe_reading(sim, &read_cube(sim))
@@ -193,6 +201,7 @@ pub struct LayerOpEnv {
     goal: Arc<LayerGoal>,
     desired: f64,
     layer: Layer,
+    starts: Option<StartMix>,
 }
 
 impl LayerOpEnv {
@@ -230,6 +239,7 @@ impl LayerOpEnv {
             goal: Arc::new(LayerGoal::default()),
             desired: layer_move.direction() * FRAC_PI_2,
             layer,
+            starts: None,
         }
     }
 
@@ -267,6 +277,43 @@ impl LayerOpEnv {
 
     pub fn set_desired_goal(&mut self, angle: f64) {
         self.desired = angle;
+    }
+
+    /// The same environment resetting from recorded starts (the operator's Stage 2 starts on
+    /// the cube, recorded with the top layer to turn), as `mix.pick` says, rather than from a
+    /// fresh placement. A start that does not fit this scene falls back to a fresh placement.
+    pub fn with_starts(mut self, mix: StartMix) -> LayerOpEnv {
+        self.starts = Some(mix);
+        self
+    }
+
+    /// Starts an episode from a recorded start, counting the layer that faces the move's
+    /// direction from the angle it had turned when recorded, with a goal drawn as at any
+    /// reset; fails, leaving the simulation as it was, if the start's physics state does not
+    /// fit this scene.
+    pub fn reset_from(&mut self, start: &RecordedStart) -> Result<(Observation, Info), SimError> {
+        self.hand.sim.restore_physics_state(&start.state)?;
+        self.hand.steps = 0;
+        Ok(self.first_observation(start.goal.get(1).copied().unwrap_or(0.0)))
+    }
+
+    /// Begins counting the layer from the object as it now lies, as already turned by
+    /// `turned`, draws the goal, and gives the episode's first observation and its info.
+    fn first_observation(&mut self, turned: f64) -> (Observation, Info) {
+        let (facing, base) = (self.layer_move.facing(), self.layer_move.base_orientation());
+        if let Layer::Cube(tracker) = &mut self.layer {
+            *tracker = CubeLayer::start(&self.hand.sim, facing, base)
+                .expect("a cube scene")
+                .counted_from(turned);
+        }
+        let size = match self.goals {
+            LayerGoals::Training => self.hand.rng.random_range(0.0..=FRAC_PI_2),
+            LayerGoals::Evaluation => FRAC_PI_2,
+        };
+        self.desired = self.layer_move.direction() * size;
+        let observation = self.layer.observe(&self.hand, &self.goal, self.desired);
+        let info = self.hand.info(&observation, self.goal.as_ref(), None);
+        (observation, info)
     }
 
     /// The same environment judged by `goal`, e.g. [`LayerGoal::square`] to also need the
@@ -342,6 +389,12 @@ impl GoalEnv for LayerOpEnv {
 
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
         self.hand.seed(seed);
+        if let Some(mix) = self.starts.clone()
+            && let Some(start) = mix.pick(seed, &mut self.hand.rng)
+            && let Ok(first) = self.reset_from(start)
+        {
+            return first;
+        }
         let (facing, base) = (self.layer_move.facing(), self.layer_move.base_orientation());
         // On the cube any face may be the turning one: its cubelets are alike. The block
         // draws nothing more, so its episodes stay as they were before the cube was an option.
@@ -359,17 +412,7 @@ impl GoalEnv for LayerOpEnv {
             };
             rotation::normalise(&rotation::mul(&rotation::mul(&spin, &base), &face))
         });
-        if let Layer::Cube(tracker) = &mut self.layer {
-            *tracker = CubeLayer::start(&self.hand.sim, facing, base).expect("a cube scene");
-        }
-        let size = match self.goals {
-            LayerGoals::Training => self.hand.rng.random_range(0.0..=FRAC_PI_2),
-            LayerGoals::Evaluation => FRAC_PI_2,
-        };
-        self.desired = self.layer_move.direction() * size;
-        let observation = self.layer.observe(&self.hand, &self.goal, self.desired);
-        let info = self.hand.info(&observation, self.goal.as_ref(), None);
-        (observation, info)
+        self.first_observation(0.0)
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {

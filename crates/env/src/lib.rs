@@ -13,7 +13,8 @@
 //! On the physical cube either goal can gain one part, the cube's misalignment, for a success
 //! test that also needs the cube left in its good state ([`RotGoal::left_square`],
 //! [`LayerGoal::square`]).
-//! - [`RecordedStart`]: where the operator began Stage 1, for CubeRotEnv to reset from.
+//! - [`RecordedStart`]: where the operator began a stage, for CubeRotEnv and LayerOpEnv to
+//!   reset from.
 //! - [`VecEnv`]: many environments stepped on a thread pool, each with its own `MjData`.
 //!
 //! Dynamics follow Gymnasium-Robotics' hand environments: an action in [-1, 1]^20 maps onto

@@ -28,7 +28,7 @@ use rand::Rng;
 use crate::goal::{Goal, RotGoal, RotMode};
 use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
 use crate::random::uniform_rotation;
-use crate::starts::{RecordedStart, StartMix, StartPick, weighted_start};
+use crate::starts::{RecordedStart, StartMix};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// The paper's three Stage 1 targets, `[w, x, y, z]`.
@@ -89,7 +89,7 @@ impl CubeRotEnv {
     pub fn reset_from(&mut self, start: &RecordedStart) -> Result<(Observation, Info), SimError> {
         self.hand.sim.restore_physics_state(&start.state)?;
         self.hand.steps = 0;
-        self.desired = start.pose_goal.clone();
+        self.desired = start.goal.clone();
         self.show_target();
         Ok(self.first_observation())
     }
@@ -186,23 +186,11 @@ impl GoalEnv for CubeRotEnv {
 
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
         self.hand.seed(seed);
-        if let Some(StartMix { starts, pick }) = self.starts.clone()
-            && !starts.is_empty()
+        if let Some(mix) = self.starts.clone()
+            && let Some(start) = mix.pick(seed, &mut self.hand.rng)
+            && let Ok(first) = self.reset_from(start)
         {
-            let rng = &mut self.hand.rng;
-            let k = match (pick, seed) {
-                (StartPick::Numbered, Some(seed)) => Some(seed as usize % starts.len()),
-                (StartPick::Share { share, .. }, _) if rng.random::<f64>() >= share => None,
-                // Weight 1 keeps the uniform draw, so runs from before the weight draw the
-                // same starts when resumed.
-                (StartPick::Share { dropped_weight, .. }, _) if dropped_weight != 1.0 => {
-                    Some(weighted_start(&starts, dropped_weight, rng.random()))
-                }
-                _ => Some(rng.random_range(0..starts.len())),
-            };
-            if let Some(Ok(first)) = k.map(|k| self.reset_from(&starts[k])) {
-                return first;
-            }
+            return first;
         }
         self.hand.place(uniform_rotation);
         let pick = self.hand.rng.random_range(0..PAPER_TARGETS.len());

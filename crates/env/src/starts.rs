@@ -1,27 +1,32 @@
-//! Episode starts recorded where the operator began Stage 1: the physics state once the hand
-//! has opened from where the last stage left it and the policy takes over, and the pose the
-//! operator asked for. CubeRotEnv can reset from them ([`CubeRotEnv::with_starts`],
-//! [`CubeRotEnv::reset_from`]), so that training and `eval-stage` see the states the
-//! operator hands Stage 1, not only a cube freshly set down on a flat hand: session 12 found
-//! that the second understates how often a policy drops the cube in the operator threefold.
-//!
-//! [`CubeRotEnv::with_starts`]: crate::CubeRotEnv::with_starts
-//! [`CubeRotEnv::reset_from`]: crate::CubeRotEnv::reset_from
+//! Episode starts recorded where the operator began a stage: the physics state once the hand
+//! has opened from where the last stage left it and the policy takes over, the goal it was
+//! given, and whether the recorded policy failed from there. CubeRotEnv and LayerOpEnv can
+//! reset from them (`with_starts`, `reset_from`), so that training and `eval-stage` see the
+//! states the operator hands a stage, not only a cube freshly set down on a flat hand:
+//! session 12 found that the second understates how often Stage 1 drops the cube in the
+//! operator threefold.
 
 use std::sync::Arc;
 
-/// One recorded start of Stage 1.
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+/// One recorded start of a stage.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordedStart {
     /// The physics state when the policy took over (`Sim::physics_state`).
     pub state: Vec<f64>,
-    /// The pose asked for: position, then quaternion (CubeRotEnv's 7-number pose goal).
-    pub pose_goal: Vec<f64>,
-    /// Whether the policy that was recorded went on to drop the cube from here.
-    pub dropped: bool,
+    /// The goal asked for: for Stage 1 the pose, position then quaternion (CubeRotEnv's
+    /// 7-number pose goal); for Stage 2 the layer angle to turn (+π/2, U'), then the angle
+    /// the layer had already turned when the policy took over, which its view counts from.
+    pub goal: Vec<f64>,
+    /// Whether the policy that was recorded failed from here, in the way its stage's training
+    /// weights: Stage 1, it dropped the cube; Stage 2, it did not leave the layer turned
+    /// within 0.1 rad of its goal with the cube in its good state (or dropped the cube).
+    pub failed: bool,
 }
 
-/// Recorded starts, and which of a CubeRotEnv's resets begin from them.
+/// Recorded starts, and which of an environment's resets begin from them.
 #[derive(Clone, Debug)]
 pub struct StartMix {
     pub starts: Arc<[RecordedStart]>,
@@ -32,19 +37,41 @@ pub struct StartMix {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum StartPick {
     /// Training: with probability `share` a reset begins from a recorded start, and
-    /// otherwise from the usual fresh placement. A start the recorded policy dropped the cube
-    /// from is drawn `dropped_weight` times as often as one it kept the cube from (1: all
-    /// alike), so that training can spend more of its episodes where drops begin.
-    Share { share: f64, dropped_weight: f64 },
+    /// otherwise from the usual fresh placement. A start the recorded policy failed from is
+    /// drawn `failed_weight` times as often as one it succeeded from (1: all alike), so
+    /// that training can spend more of its episodes where failures begin.
+    Share { share: f64, failed_weight: f64 },
     /// Evaluation: a reset with seed k begins from start k (modulo their number), so that
     /// episodes 0 to n - 1 visit each start once.
     Numbered,
 }
 
-/// The start a draw `u`, uniform in [0, 1), picks when each start the recorded policy dropped
-/// the cube from weighs `dropped_weight` and each other start 1.
-pub(crate) fn weighted_start(starts: &[RecordedStart], dropped_weight: f64, u: f64) -> usize {
-    let weight = |start: &RecordedStart| if start.dropped { dropped_weight } else { 1.0 };
+impl StartMix {
+    /// The start a reset with `seed` begins from, if any, drawing from `rng` as
+    /// [`StartPick`] says; `None` for a fresh placement.
+    pub(crate) fn pick(&self, seed: Option<u64>, rng: &mut ChaCha8Rng) -> Option<&RecordedStart> {
+        let starts = &self.starts;
+        if starts.is_empty() {
+            return None;
+        }
+        let k = match (self.pick, seed) {
+            (StartPick::Numbered, Some(seed)) => seed as usize % starts.len(),
+            (StartPick::Share { share, .. }, _) if rng.random::<f64>() >= share => return None,
+            // Weight 1 keeps the uniform draw, so runs from before the weight draw the same
+            // starts when resumed.
+            (StartPick::Share { failed_weight, .. }, _) if failed_weight != 1.0 => {
+                weighted_start(starts, failed_weight, rng.random())
+            }
+            _ => rng.random_range(0..starts.len()),
+        };
+        Some(&starts[k])
+    }
+}
+
+/// The start a draw `u`, uniform in [0, 1), picks when each start the recorded policy failed
+/// from weighs `failed_weight` and each other start 1.
+fn weighted_start(starts: &[RecordedStart], failed_weight: f64, u: f64) -> usize {
+    let weight = |start: &RecordedStart| if start.failed { failed_weight } else { 1.0 };
     let total: f64 = starts.iter().map(weight).sum();
     let mut left = u * total;
     for (k, start) in starts.iter().enumerate() {
@@ -60,14 +87,14 @@ pub(crate) fn weighted_start(starts: &[RecordedStart], dropped_weight: f64, u: f
 mod tests {
     use super::*;
 
-    /// A dropped start of weight 2 between two kept ones takes half of the draws, the middle
+    /// A failed start of weight 2 between two others takes half of the draws, the middle
     /// half; weight 1 gives each a third.
     #[test]
-    fn a_dropped_start_is_drawn_in_proportion_to_its_weight() {
-        let start = |dropped| RecordedStart {
+    fn a_failed_start_is_drawn_in_proportion_to_its_weight() {
+        let start = |failed| RecordedStart {
             state: vec![],
-            pose_goal: vec![],
-            dropped,
+            goal: vec![],
+            failed,
         };
         let starts = [start(false), start(true), start(false)];
         let picks = |weight, draws: &[f64]| -> Vec<usize> {

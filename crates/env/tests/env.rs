@@ -426,8 +426,8 @@ fn cube_rot_env_resets_from_recorded_starts() {
             }
             RecordedStart {
                 state: source.sim().physics_state(),
-                pose_goal: pose_goal(source.resting_point(), PAPER_TARGETS[k as usize + 1]),
-                dropped: false,
+                goal: pose_goal(source.resting_point(), PAPER_TARGETS[k as usize + 1]),
+                failed: false,
             }
         })
         .collect();
@@ -443,7 +443,7 @@ fn cube_rot_env_resets_from_recorded_starts() {
 
     let mut numbered = env(StartPick::Numbered);
     let (first, _) = numbered.reset(Some(3));
-    assert_eq!(first.desired_goal, starts[1].pose_goal);
+    assert_eq!(first.desired_goal, starts[1].goal);
     assert_eq!(numbered.sim().physics_state(), starts[1].state);
     assert_eq!(numbered.step(&action).observation, continued);
     numbered.reset(Some(0));
@@ -451,7 +451,7 @@ fn cube_rot_env_resets_from_recorded_starts() {
 
     let share = |share| StartPick::Share {
         share,
-        dropped_weight: 1.0,
+        failed_weight: 1.0,
     };
     let (mut never, mut always) = (env(share(0.0)), env(share(1.0)));
     let recorded = |env: &CubeRotEnv| starts.iter().any(|s| s.state == env.sim().physics_state());

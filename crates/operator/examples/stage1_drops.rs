@@ -68,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let mut replays = Vec::new();
     for (k, start) in starts.iter().enumerate() {
-        if dropped_only && !start.dropped {
+        if dropped_only && !start.failed {
             continue;
         }
         let (mut observation, _) = env.reset(Some(k as u64));

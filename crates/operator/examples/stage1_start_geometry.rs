@@ -57,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (recorded, _) = dexcube_rl::start_file::load_starts(Path::new(path))?;
         for start in &recorded {
             env.reset_from(start)?;
-            let target: Quat = start.pose_goal[3..7].try_into()?;
+            let target: Quat = start.goal[3..7].try_into()?;
             let orientation = env.sim().object_pose().orientation;
             // A face's outward normal in the world, and how far it leans from vertical.
             let normal = |face| rotate(&orientation, face_normal(face));
@@ -72,7 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 lean,
                 tilt: leaning(axis),
                 azimuth: axis[1].atan2(axis[0]).to_degrees(),
-                dropped: start.dropped,
+                dropped: start.failed,
             });
         }
     }

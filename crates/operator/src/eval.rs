@@ -15,7 +15,10 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::operator::{Operator, OperatorConfig, Planner, StageRecord, set_up_scramble};
-use crate::stages::{Driving, PolicyStage1, PolicyStage2, RecordingStage1, Stage1, pose_reached};
+use crate::stages::{
+    Driving, PolicyStage1, PolicyStage2, RecordingStage1, RecordingStage2, Stage1, Stage2,
+    pose_reached,
+};
 
 /// The paper's Table I, move distances 1 to 14.
 pub const PAPER_SR_ROLLBACK: [f64; 14] = [
@@ -150,11 +153,13 @@ impl CubeResult {
 }
 
 /// Callbacks while a cube is solved: after every control step, and at every event; and
-/// where to record Stage 1's starts, if anywhere ([`RecordingStage1`]).
+/// where to record each stage's starts, if anywhere ([`RecordingStage1`],
+/// [`RecordingStage2`]).
 pub struct Hooks<'a> {
     pub watch: &'a mut dyn FnMut(&mut Sim),
     pub narrate: &'a mut dyn FnMut(&crate::Event),
     pub stage1_starts: Option<&'a mut Vec<RecordedStart>>,
+    pub stage2_starts: Option<&'a mut Vec<RecordedStart>>,
 }
 
 /// Solves one scrambled cube with the hand. The cube is made from `scramble` on the palm;
@@ -184,11 +189,22 @@ pub fn run_cube(
         }
         None => &mut stages.stage1,
     };
+    let mut recording2;
+    let stage2: &mut dyn Stage2 = match hooks.stage2_starts {
+        Some(starts) => {
+            recording2 = RecordingStage2 {
+                inner: &mut stages.stage2,
+                starts,
+            };
+            &mut recording2
+        }
+        None => &mut stages.stage2,
+    };
     let mut operator = Operator {
         config,
         stage1,
         stage1_accepts: &accepts,
-        stage2: &mut stages.stage2,
+        stage2,
         planner,
         resting,
         rng: ChaCha8Rng::seed_from_u64(seed),

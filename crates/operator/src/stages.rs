@@ -389,8 +389,53 @@ impl Stage1 for RecordingStage1<'_> {
         if let Some(state) = state {
             self.starts.push(RecordedStart {
                 state,
-                pose_goal: pose_goal(position, target),
-                dropped: run.dropped,
+                goal: pose_goal(position, target),
+                failed: run.dropped,
+            });
+        }
+        run
+    }
+}
+
+/// A Stage 2 that records where each of its runs hands over to the policy: the physics state
+/// once the hand has opened (after [`OPENING_STEPS`]), the quarter turn asked for and the
+/// angle the layer had already turned while the hand opened (the policy's view counts from
+/// the stage's start), and whether the run then failed by the square test
+/// ([`LayerGoal::square`]: the top layer turned within 0.1 rad of U', with the cube in its
+/// good state, and not dropped). A run that dropped the cube while the hand opened records
+/// nothing.
+pub struct RecordingStage2<'a> {
+    pub inner: &'a mut dyn Stage2,
+    pub starts: &'a mut Vec<RecordedStart>,
+}
+
+impl Stage2 for RecordingStage2<'_> {
+    fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
+        let Some(mut view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
+            return self.inner.run(sim, watch);
+        };
+        let (mut steps, mut start) = (0, None);
+        let mut recording = |sim: &mut Sim| {
+            watch(sim);
+            steps += 1;
+            // Every step, so that the layer angle unwraps as the policy's own view does.
+            view.observe(sim);
+            if steps == OPENING_STEPS {
+                start = Some((sim.physics_state(), view.turned()));
+            }
+        };
+        let run = self.inner.run(sim, &mut recording);
+        if let Some((state, opened)) = start {
+            let test = LayerGoal::square();
+            let misalignment = CubeState::read(sim).map_or(f64::INFINITY, |c| c.misalignment());
+            let reached = test.is_success(
+                &test.achieved(view.turned(), misalignment),
+                &test.desired(FRAC_PI_2),
+            );
+            self.starts.push(RecordedStart {
+                state,
+                goal: vec![FRAC_PI_2, opened],
+                failed: run.dropped || run.diverged || !reached,
             });
         }
         run

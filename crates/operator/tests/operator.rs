@@ -4,18 +4,19 @@
 
 use dexcube_cube::Face;
 use dexcube_cube::{CostTable, DistanceTable, Solver, scrambles_at_distance};
+use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{
-    CubeRotEnv, EPISODE_STEPS, GoalEnv, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick,
+    CubeRotEnv, EPISODE_STEPS, LayerOpEnv, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick,
 };
 use dexcube_operator::stages::{
-    Driving, KinematicStage1, KinematicStage2, OPENING_STEPS, RecordingStage1, Stage1, Stage2,
-    StageRun, Steadier, Steadying, Watch, pose_reached, randomise_pose,
+    Driving, KinematicStage1, KinematicStage2, OPENING_STEPS, RecordingStage1, RecordingStage2,
+    Stage1, Stage2, StageRun, Steadier, Steadying, Watch, pose_reached, randomise_pose,
 };
 use dexcube_operator::{
     AlreadyUp, Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price,
     move_plan, set_up_scramble,
 };
-use dexcube_sim::cube::{CubeState, snap_layers};
+use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, snap_layers};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{Pose, Scene, SceneKind, Sim};
 use rand::SeedableRng;
@@ -652,7 +653,7 @@ fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
     }
     .run(&mut sim, resting, target, &mut |_| {});
     assert_eq!(starts.len(), 1, "one run, one start");
-    assert_eq!(starts[0].dropped, run.dropped);
+    assert_eq!(starts[0].failed, run.dropped);
     assert_eq!(run.steps, OPENING_STEPS + EPISODE_STEPS);
 
     let mix = StartMix {
@@ -660,14 +661,55 @@ fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
         pick: StartPick::Numbered,
     };
     let mut env = CubeRotEnv::with_scene(scene, stages.stage1.goal).with_starts(mix);
-    let (mut obs, _) = env.reset(Some(0));
-    for _ in 0..EPISODE_STEPS {
-        let action = stages
-            .stage1
-            .policy
-            .act(&obs.observation, &obs.desired_goal);
-        obs = env.step(&action).observation;
-    }
+    replay(&mut env, &stages.stage1.policy);
     assert_eq!(env.sim().object_pose(), sim.object_pose());
     assert_eq!(env.sim().hand_angles(), sim.hand_angles());
+}
+
+/// Runs `policy` for an episode from `env`'s reset with seed 0 (its first recorded start),
+/// or until the episode ends.
+fn replay(env: &mut dyn SimulatedEnv, policy: &dexcube_rl::Policy) {
+    let (mut obs, _) = env.reset(Some(0));
+    for _ in 0..EPISODE_STEPS {
+        let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
+        if t.terminated {
+            return;
+        }
+        obs = t.observation;
+    }
+}
+
+/// The same for Stage 2: a LayerOpEnv U' reset from a recorded Stage 2 start and run with the
+/// same policy ends exactly where the operator's Stage 2 did, and the start is marked failed
+/// exactly when the layer did not end a quarter turn round (within 0.1 rad) with the cube in
+/// its good state.
+#[test]
+fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
+    let (mut stages, resting) = shipped_stages();
+    let scene = Scene::load(SceneKind::Cube).unwrap();
+    let mut sim = Sim::new(scene.clone());
+    set_up_scramble(&mut sim, &[], resting);
+    sim.set_action(&[0.3; dexcube_sim::HAND_ACTUATORS]);
+    let mut starts = Vec::new();
+    let run = RecordingStage2 {
+        inner: &mut stages.stage2,
+        starts: &mut starts,
+    }
+    .run(&mut sim, &mut |_| {});
+    assert_eq!(starts.len(), 1, "one run, one start");
+    assert_eq!(run.steps, OPENING_STEPS + EPISODE_STEPS);
+
+    let mix = StartMix {
+        starts: starts.clone().into(),
+        pick: StartPick::Numbered,
+    };
+    let mut env = LayerOpEnv::with_scene(scene, LayerMove::UPrime, LayerGoals::Evaluation)
+        .with_goal(stages.stage2.goal)
+        .with_starts(mix);
+    replay(&mut env, &stages.stage2.policy);
+    assert_eq!(env.sim().object_pose(), sim.object_pose());
+    assert_eq!(env.sim().hand_angles(), sim.hand_angles());
+    let square = CubeState::read(&sim).unwrap().misalignment() < ALIGNED_TOLERANCE;
+    let turned = (env.layer_angle() - std::f64::consts::FRAC_PI_2).abs() < 0.1;
+    assert_eq!(starts[0].failed, !(turned && square && !run.dropped));
 }

@@ -1,7 +1,9 @@
-//! Recorded Stage 1 starts ([`RecordedStart`]) on disk: one safetensors file of float64
-//! tensors, `state` (starts × state size), `pose_goal` (starts × 7) and `dropped` (starts),
-//! with the scene and the command that recorded them in its metadata. Written atomically, and
-//! checked on loading, like a checkpoint.
+//! Recorded starts of a stage ([`RecordedStart`]) on disk: one safetensors file of float64
+//! tensors, `state` (starts × state size), `goal` (starts × goal size: 7 for Stage 1's pose,
+//! 1 for Stage 2's angle) and `failed` (starts), with the stage, the scene and the command
+//! that recorded them in its metadata. Written atomically, and checked on loading, like a
+//! checkpoint. Files from before Stage 2 starts (sessions 13 to 18) name the goal
+//! `pose_goal` and the failures `dropped`, hold Stage 1's, and are read as such.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -14,24 +16,25 @@ use crate::checkpoint::{CheckpointError, RawTensor, write_safetensors};
 /// What a file of starts says about where they came from.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StartsOrigin {
+    /// The stage whose starts they are: "rot" (Stage 1) or "layer" (Stage 2).
+    pub stage: String,
     /// The scene the states belong to ("cube").
     pub scene: String,
     /// The command that recorded them.
     pub command: String,
 }
 
-const POSE_GOAL: usize = 7;
-
-/// Writes `starts` (all of one state size) with their origin.
+/// Writes `starts` (all of one state size and one goal size) with their origin.
 pub fn save_starts(
     path: &Path,
     starts: &[RecordedStart],
     origin: &StartsOrigin,
 ) -> Result<(), CheckpointError> {
     let size = starts.first().map_or(0, |s| s.state.len());
+    let goal_size = starts.first().map_or(0, |s| s.goal.len());
     if starts
         .iter()
-        .any(|s| s.state.len() != size || s.pose_goal.len() != POSE_GOAL)
+        .any(|s| s.state.len() != size || s.goal.len() != goal_size)
     {
         return Err(CheckpointError::Io {
             path: path.to_path_buf(),
@@ -55,23 +58,21 @@ pub fn save_starts(
                 .collect(),
         ),
         tensor(
-            "pose_goal",
-            vec![n, POSE_GOAL],
-            starts
-                .iter()
-                .flat_map(|s| s.pose_goal.iter().copied())
-                .collect(),
+            "goal",
+            vec![n, goal_size],
+            starts.iter().flat_map(|s| s.goal.iter().copied()).collect(),
         ),
         tensor(
-            "dropped",
+            "failed",
             vec![n],
             starts
                 .iter()
-                .map(|s| f64::from(u8::from(s.dropped)))
+                .map(|s| f64::from(u8::from(s.failed)))
                 .collect(),
         ),
     ];
     let metadata = HashMap::from([
+        ("stage".to_string(), origin.stage.clone()),
         ("scene".to_string(), origin.scene.clone()),
         ("command".to_string(), origin.command.clone()),
     ]);
@@ -83,7 +84,8 @@ pub fn load_starts(path: &Path) -> Result<(Vec<RecordedStart>, StartsOrigin), Ch
     let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io {
         path: path.to_path_buf(),
         message: format!(
-            "{e} (record starts with `dexcube eval ... --record-starts {}`)",
+            "{e} (record starts with `dexcube eval ... --record-starts {}`, or \
+             `--record-layer-starts` for Stage 2's)",
             path.display()
         ),
     })?;
@@ -109,27 +111,34 @@ pub fn load_starts(path: &Path) -> Result<(Vec<RecordedStart>, StartsOrigin), Ch
         Ok((view.shape().to_vec(), values))
     };
     let (state_shape, states) = tensor("state")?;
-    let (goal_shape, goals) = tensor("pose_goal")?;
-    let (dropped_shape, dropped) = tensor("dropped")?;
-    let [n, size] = state_shape[..] else {
-        return Err(corrupt(format!("'state' has shape {state_shape:?}")));
-    };
-    if goal_shape != [n, POSE_GOAL] || dropped_shape != [n] || (size == 0 && n > 0) {
+    let legacy = file.tensor("goal").is_err();
+    let (goal_shape, goals) = tensor(if legacy { "pose_goal" } else { "goal" })?;
+    let (failed_shape, failed) = tensor(if legacy { "dropped" } else { "failed" })?;
+    let (&[n, size], &[goal_n, goal_size]) = (&state_shape[..], &goal_shape[..]) else {
         return Err(corrupt(format!(
-            "shapes {state_shape:?}, {goal_shape:?} and {dropped_shape:?} do not agree"
+            "'state' has shape {state_shape:?} and 'goal' {goal_shape:?}"
+        )));
+    };
+    if goal_n != n || failed_shape != [n] || (size == 0 && n > 0) {
+        return Err(corrupt(format!(
+            "shapes {state_shape:?}, {goal_shape:?} and {failed_shape:?} do not agree"
         )));
     }
     let metadata = header.metadata().clone().unwrap_or_default();
     let field = |key: &str| metadata.get(key).cloned().unwrap_or_default();
     let origin = StartsOrigin {
+        stage: metadata
+            .get("stage")
+            .cloned()
+            .unwrap_or_else(|| "rot".into()),
         scene: field("scene"),
         command: field("command"),
     };
     let starts = (0..n)
         .map(|k| RecordedStart {
             state: states[k * size..(k + 1) * size].to_vec(),
-            pose_goal: goals[k * POSE_GOAL..(k + 1) * POSE_GOAL].to_vec(),
-            dropped: dropped[k] != 0.0,
+            goal: goals[k * goal_size..(k + 1) * goal_size].to_vec(),
+            failed: failed[k] != 0.0,
         })
         .collect();
     Ok((starts, origin))
@@ -146,11 +155,12 @@ mod tests {
         let starts: Vec<RecordedStart> = (0..3)
             .map(|k| RecordedStart {
                 state: vec![k as f64, 0.5, -1e-9],
-                pose_goal: vec![0.1 * k as f64; POSE_GOAL],
-                dropped: k == 1,
+                goal: vec![0.1 * k as f64; 7],
+                failed: k == 1,
             })
             .collect();
         let origin = StartsOrigin {
+            stage: "rot".into(),
             scene: "cube".into(),
             command: "dexcube eval --record-starts x".into(),
         };
@@ -169,5 +179,22 @@ mod tests {
         uneven[2].state.pop();
         assert!(save_starts(&path, &uneven, &origin).is_err());
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// The files sessions 13 to 18 recorded (goal named `pose_goal`, failures `dropped`, no
+    /// stage) read as Stage 1's, with their drops as the failures.
+    #[test]
+    fn a_file_from_before_stage_2_starts_reads_as_stage_1s() {
+        let committed = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../results/starts/starts-select-seed2.safetensors"
+        );
+        let (starts, origin) = load_starts(Path::new(committed)).expect("loaded");
+        assert_eq!(origin.stage, "rot");
+        assert_eq!(origin.scene, "cube");
+        assert_eq!(starts.len(), 1254);
+        assert!(starts.iter().all(|s| s.goal.len() == 7));
+        // The policy that recorded them (session 13's Stage 1) dropped the cube from 19.
+        assert_eq!(starts.iter().filter(|s| s.failed).count(), 19);
     }
 }
