@@ -25,7 +25,9 @@
 //! angle about that direction, at the resting point plus N(0, 5 mm) noise, with its layers
 //! aligned, and left to settle. For training the goal angle is uniform in [0, π/2]
 //! (counter-clockwise) or [-π/2, 0] (clockwise), as the authors did, so HER sees
-//! intermediate goals; for evaluation it is exactly ±π/2.
+//! intermediate goals; for evaluation it is exactly ±π/2. With recorded starts
+//! ([`LayerOpEnv::with_starts`]) a reset may instead restore where the operator handed Stage 2
+//! the cube, for U' (the move the operator turns).
 
 use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
