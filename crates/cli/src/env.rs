@@ -37,6 +37,30 @@ impl EnvKind {
             EnvKind::Layer => "layer",
         }
     }
+
+    /// The stage's name in the paper's terms.
+    pub fn stage(self) -> &'static str {
+        match self {
+            EnvKind::Rot => "Stage 1",
+            EnvKind::Layer => "Stage 2",
+        }
+    }
+
+    /// The `dexcube eval` flag that records this stage's starts.
+    pub fn record_flag(self) -> &'static str {
+        match self {
+            EnvKind::Rot => "--record-starts",
+            EnvKind::Layer => "--record-layer-starts",
+        }
+    }
+
+    /// What a recorded start marks as this stage's failure.
+    pub fn recorded_failure(self) -> &'static str {
+        match self {
+            EnvKind::Rot => "dropped the cube",
+            EnvKind::Layer => "did not leave the layer turned with the cube square",
+        }
+    }
 }
 
 #[derive(Args)]
@@ -285,15 +309,12 @@ pub fn starts_for(
     }
     if origin.stage != stage.name() {
         bail!(
-            "{} holds {} starts, not {}'s: record {} with `dexcube eval {}`",
+            "{} holds {} starts, not {}'s: record {} with `dexcube eval {} FILE`",
             path.display(),
             origin.stage,
             stage.name(),
             stage.name(),
-            match stage {
-                EnvKind::Rot => "--record-starts FILE",
-                EnvKind::Layer => "--record-layer-starts FILE",
-            }
+            stage.record_flag()
         );
     }
     let name = scene.kind().name();

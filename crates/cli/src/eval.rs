@@ -498,26 +498,20 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     save(&results)?;
     let mut recorded = recorded.into_inner().expect("lock");
     recorded.sort_by_key(|(k, _)| *k);
-    let record_flags: String = [
-        ("--record-starts", &args.record_starts),
-        ("--record-layer-starts", &args.record_layer_starts),
-    ]
-    .iter()
-    .filter_map(|(flag, path)| path.as_ref().map(|p| format!(" {flag} {}", p.display())))
-    .collect();
+    let record_flags: String = recording
+        .iter()
+        .filter_map(|(stage, path)| {
+            let path = path.as_ref()?;
+            Some(format!(" {} {}", stage.record_flag(), path.display()))
+        })
+        .collect();
     for (stage_index, (stage, path)) in recording.into_iter().enumerate() {
         let Some(path) = path else { continue };
         let starts: Vec<_> = recorded
             .iter_mut()
             .flat_map(|(_, s)| std::mem::take(&mut s[stage_index]))
             .collect();
-        let (name, failure) = match stage {
-            EnvKind::Rot => ("Stage 1", "dropped the cube"),
-            EnvKind::Layer => (
-                "Stage 2",
-                "did not leave the layer turned with the cube square",
-            ),
-        };
+        let (name, failure) = (stage.stage(), stage.recorded_failure());
         if starts.is_empty() {
             bail!(
                 "no {name} run began with the hand open in these cubes, so {} was not written: \
@@ -821,10 +815,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 EnvKind::Rot => {
                     let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
                     let env = CubeRotEnv::with_scene(scene.clone(), goal);
-                    Box::new(match numbered(&starts) {
-                        Some(mix) => env.with_starts(mix),
-                        None => env,
-                    })
+                    Box::new(env.with_starts(numbered(&starts)))
                 }
                 EnvKind::Layer => {
                     let env = LayerOpEnv::with_scene(
@@ -833,10 +824,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                         LayerGoals::Evaluation,
                     )
                     .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?);
-                    Box::new(match numbered(&starts) {
-                        Some(mix) => env.with_starts(mix),
-                        None => env,
-                    })
+                    Box::new(env.with_starts(numbered(&starts)))
                 }
             };
             Ok((policy, env))
@@ -917,10 +905,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if starts.is_some() {
-        let failure = match args.stage {
-            EnvKind::Rot => "dropped the cube",
-            EnvKind::Layer => "did not leave the layer turned with the cube square",
-        };
+        let failure = args.stage.recorded_failure();
         println!(
             "  starts from which the recorded policy {failure}: {recorded_failures}; this one failed so from {} of them",
             failures_again.into_inner()

@@ -360,13 +360,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let trained = match args.choice.env {
         EnvKind::Rot => {
             let goal = args.choice.rot_goal()?;
-            let make = || {
-                let env = CubeRotEnv::with_scene(scene.clone(), goal);
-                match &starts {
-                    Some(mix) => env.with_starts(mix.clone()),
-                    None => env,
-                }
-            };
+            let make = || CubeRotEnv::with_scene(scene.clone(), goal).with_starts(starts.clone());
             train(make, config, &options)?
         }
         EnvKind::Layer => {
@@ -377,11 +371,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 LayerGoals::Training
             };
             let make = || {
-                let env = LayerOpEnv::with_scene(scene.clone(), layer_move, goals).with_goal(goal);
-                match &starts {
-                    Some(mix) => env.with_starts(mix.clone()),
-                    None => env,
-                }
+                LayerOpEnv::with_scene(scene.clone(), layer_move, goals)
+                    .with_goal(goal)
+                    .with_starts(starts.clone())
             };
             train(make, config, &options)?
         }

@@ -150,13 +150,26 @@ impl CubeLayer {
         self.observe_reading(sim, &read_cube(sim))
     }
 
-    /// The same from `state`, a reading of the cube in `sim` already taken.
-    fn observe_reading(&mut self, sim: &Sim, state: &CubeState) -> Vec<f64> {
+    /// Follows the layer angle to `sim`'s state without building an observation, for a
+    /// watcher that needs only the angle; it must be called as often as the policy observes,
+    /// every control step, for the angle to unwrap the same way.
+    pub fn follow(&mut self, sim: &Sim) -> f64 {
+        self.follow_reading(&read_cube(sim));
+        self.turned
+    }
+
+    /// Readings wrap at ±45°: accumulates the change since the last reading, brought into
+    /// ±45°.
+    fn follow_reading(&mut self, state: &CubeState) {
         let now = state.layer_angle(self.face);
-        // Readings wrap at ±45°: accumulate the change, brought into ±45°.
         let change = now - self.last;
         self.turned += change - FRAC_PI_2 * (change / FRAC_PI_2).round();
         self.last = now;
+    }
+
+    /// The same from `state`, a reading of the cube in `sim` already taken.
+    fn observe_reading(&mut self, sim: &Sim, state: &CubeState) -> Vec<f64> {
+        self.follow_reading(state);
         let (frame, spin) = state.layer_behind(self.face);
         let (symmetry, _) = rotation::snap_to_cube(
             &rotation::mul(&rotation::conj(&frame), &self.base),
@@ -281,11 +294,12 @@ impl LayerOpEnv {
         self.desired = angle;
     }
 
-    /// The same environment resetting from recorded starts (the operator's Stage 2 starts on
-    /// the cube, recorded with the top layer to turn), as `mix.pick` says, rather than from a
-    /// fresh placement. A start that does not fit this scene falls back to a fresh placement.
-    pub fn with_starts(mut self, mix: StartMix) -> LayerOpEnv {
-        self.starts = Some(mix);
+    /// The same environment resetting from recorded starts if `mix` is given (the operator's
+    /// Stage 2 starts on the cube, recorded with the top layer to turn), as its pick says,
+    /// rather than from a fresh placement. A start that does not fit this scene falls back
+    /// to a fresh placement.
+    pub fn with_starts(mut self, mix: Option<StartMix>) -> LayerOpEnv {
+        self.starts = mix;
         self
     }
 

@@ -76,11 +76,11 @@ impl CubeRotEnv {
         }
     }
 
-    /// The same environment resetting from recorded starts, as `mix.pick` says, rather than
-    /// from a fresh placement. The starts must come from this environment's scene; one that
-    /// does not fit falls back to a fresh placement.
-    pub fn with_starts(mut self, mix: StartMix) -> CubeRotEnv {
-        self.starts = Some(mix);
+    /// The same environment resetting from recorded starts if `mix` is given, as its pick
+    /// says, rather than from a fresh placement. The starts must come from this environment's
+    /// scene; one that does not fit falls back to a fresh placement.
+    pub fn with_starts(mut self, mix: Option<StartMix>) -> CubeRotEnv {
+        self.starts = mix;
         self
     }
 

@@ -438,7 +438,7 @@ fn cube_rot_env_resets_from_recorded_starts() {
             starts: starts.clone().into(),
             pick,
         };
-        CubeRotEnv::with_scene(scene.clone(), goal).with_starts(mix)
+        CubeRotEnv::with_scene(scene.clone(), goal).with_starts(Some(mix))
     };
 
     let mut numbered = env(StartPick::Numbered);

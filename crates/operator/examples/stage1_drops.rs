@@ -59,10 +59,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
     let goal = PolicyStage1::trained_goal(&policy, RotMode::Pair, &prefix)?;
     let mut env =
-        CubeRotEnv::with_scene(Scene::load(SceneKind::Cube)?, goal).with_starts(StartMix {
+        CubeRotEnv::with_scene(Scene::load(SceneKind::Cube)?, goal).with_starts(Some(StartMix {
             starts: starts.clone(),
             pick: StartPick::Numbered,
-        });
+        }));
     let centre = env.resting_point();
     println!("{} starts from `{}`", starts.len(), origin.command);
 

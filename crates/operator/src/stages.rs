@@ -419,9 +419,9 @@ impl Stage2 for RecordingStage2<'_> {
             watch(sim);
             steps += 1;
             // Every step, so that the layer angle unwraps as the policy's own view does.
-            view.observe(sim);
+            let turned = view.follow(sim);
             if steps == OPENING_STEPS {
-                start = Some((sim.physics_state(), view.turned()));
+                start = Some((sim.physics_state(), turned));
             }
         };
         let run = self.inner.run(sim, &mut recording);

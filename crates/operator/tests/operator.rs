@@ -640,11 +640,7 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
 /// operator hands the cube over.
 #[test]
 fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
-    let (mut stages, resting) = shipped_stages();
-    let scene = Scene::load(SceneKind::Cube).unwrap();
-    let mut sim = Sim::new(scene.clone());
-    set_up_scramble(&mut sim, &[], resting);
-    sim.set_action(&[0.3; dexcube_sim::HAND_ACTUATORS]);
+    let (mut stages, resting, scene, mut sim) = solved_cube_on_a_bent_hand();
     let target = dexcube_operator::stages::stage1_target(Face::R);
     let mut starts = Vec::new();
     let run = RecordingStage1 {
@@ -660,10 +656,26 @@ fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
         starts: starts.into(),
         pick: StartPick::Numbered,
     };
-    let mut env = CubeRotEnv::with_scene(scene, stages.stage1.goal).with_starts(mix);
+    let mut env = CubeRotEnv::with_scene(scene, stages.stage1.goal).with_starts(Some(mix));
     replay(&mut env, &stages.stage1.policy);
     assert_eq!(env.sim().object_pose(), sim.object_pose());
     assert_eq!(env.sim().hand_angles(), sim.hand_angles());
+}
+
+/// The shipped stages, and a solved cube resting on the palm of a hand whose targets are
+/// bent away from flat, so that the stage's opening has something to do.
+fn solved_cube_on_a_bent_hand() -> (
+    dexcube_operator::eval::LoadedStages,
+    [f64; 3],
+    std::sync::Arc<Scene>,
+    Sim,
+) {
+    let (stages, resting) = shipped_stages();
+    let scene = Scene::load(SceneKind::Cube).unwrap();
+    let mut sim = Sim::new(scene.clone());
+    set_up_scramble(&mut sim, &[], resting);
+    sim.set_action(&[0.3; dexcube_sim::HAND_ACTUATORS]);
+    (stages, resting, scene, sim)
 }
 
 /// Runs `policy` for an episode from `env`'s reset with seed 0 (its first recorded start),
@@ -685,11 +697,7 @@ fn replay(env: &mut dyn SimulatedEnv, policy: &dexcube_rl::Policy) {
 /// its good state.
 #[test]
 fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
-    let (mut stages, resting) = shipped_stages();
-    let scene = Scene::load(SceneKind::Cube).unwrap();
-    let mut sim = Sim::new(scene.clone());
-    set_up_scramble(&mut sim, &[], resting);
-    sim.set_action(&[0.3; dexcube_sim::HAND_ACTUATORS]);
+    let (mut stages, _, scene, mut sim) = solved_cube_on_a_bent_hand();
     let mut starts = Vec::new();
     let run = RecordingStage2 {
         inner: &mut stages.stage2,
@@ -705,7 +713,7 @@ fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
     };
     let mut env = LayerOpEnv::with_scene(scene, LayerMove::UPrime, LayerGoals::Evaluation)
         .with_goal(stages.stage2.goal)
-        .with_starts(mix);
+        .with_starts(Some(mix));
     replay(&mut env, &stages.stage2.policy);
     assert_eq!(env.sim().object_pose(), sim.object_pose());
     assert_eq!(env.sim().hand_angles(), sim.hand_angles());

@@ -1,6 +1,6 @@
 //! Recorded starts of a stage ([`RecordedStart`]) on disk: one safetensors file of float64
 //! tensors, `state` (starts × state size), `goal` (starts × goal size: 7 for Stage 1's pose,
-//! 1 for Stage 2's angle) and `failed` (starts), with the stage, the scene and the command
+//! 2 for Stage 2's angle and the angle already turned) and `failed` (starts), with the stage, the scene and the command
 //! that recorded them in its metadata. Written atomically, and checked on loading, like a
 //! checkpoint. Files from before Stage 2 starts (sessions 13 to 18) name the goal
 //! `pose_goal` and the failures `dropped`, hold Stage 1's, and are read as such.
