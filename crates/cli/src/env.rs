@@ -7,7 +7,8 @@ use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeRotEnv, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode,
+    CubeRotEnv, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RotGoal,
+    RotMode,
 };
 use dexcube_sim::Scene;
 use rand::{Rng, SeedableRng};
@@ -54,11 +55,11 @@ impl EnvKind {
         }
     }
 
-    /// What a recorded start marks as this stage's failure.
-    pub fn recorded_failure(self) -> &'static str {
+    /// What `dexcube eval` marks as this stage's failure when it records the stage's starts.
+    pub fn recorded_failure(self) -> RecordedFailure {
         match self {
-            EnvKind::Rot => "dropped the cube",
-            EnvKind::Layer => "did not leave the layer turned with the cube square",
+            EnvKind::Rot => RecordedFailure::DroppedOrMissed,
+            EnvKind::Layer => RecordedFailure::NotSquare,
         }
     }
 }
@@ -296,13 +297,16 @@ fn policy_name(policy: PolicyArg) -> &'static str {
     }
 }
 
-/// Loads recorded starts of `stage` for `scene`, refusing a file of another stage, another
-/// scene or another state size with a message that says so.
+/// Loads recorded starts of `stage` for `scene`, with what their failure marks mean, refusing
+/// a file of another stage, another scene or another state size with a message that says so.
 pub fn starts_for(
     path: &std::path::Path,
     scene: &std::sync::Arc<Scene>,
     stage: EnvKind,
-) -> anyhow::Result<std::sync::Arc<[dexcube_env::RecordedStart]>> {
+) -> anyhow::Result<(
+    std::sync::Arc<[dexcube_env::RecordedStart]>,
+    RecordedFailure,
+)> {
     let (starts, origin) = dexcube_rl::start_file::load_starts(path)?;
     if starts.is_empty() {
         bail!("{} holds no starts", path.display());
@@ -336,5 +340,5 @@ pub fn starts_for(
             origin.command
         );
     }
-    Ok(starts.into())
+    Ok((starts.into(), origin.failure))
 }

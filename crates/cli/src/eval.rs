@@ -12,8 +12,8 @@ use clap::Args;
 use dexcube_cube::{CostTable, DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode, SimulatedEnv,
-    StartMix, StartPick, is_square,
+    CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RotGoal,
+    RotMode, SimulatedEnv, StartMix, StartPick, is_square,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
@@ -320,12 +320,14 @@ pub struct EvalArgs {
     #[command(flatten)]
     operator: OperatorArgs,
     /// Also record where every Stage 1 run began (the physics state once the hand has
-    /// opened, and the pose asked for) into this file, for `train rot --starts` and
-    /// `eval-stage rot --starts`. Needs a fresh --out.
+    /// opened, and the pose asked for) into this file, each marked failed if the run dropped
+    /// the cube or ended without the pose the check after Stage 1 accepts, for
+    /// `train rot --starts` and `eval-stage rot --starts`. Needs a fresh --out.
     #[arg(long, value_name = "FILE")]
     record_starts: Option<PathBuf>,
     /// Also record where every Stage 2 run began (the physics state once the hand has
-    /// opened) into this file, for `train layer --starts` and `eval-stage layer --starts`.
+    /// opened) into this file, each marked failed if the run did not leave the layer turned
+    /// with the cube square, for `train layer --starts` and `eval-stage layer --starts`.
     /// Needs a fresh --out.
     #[arg(long, value_name = "FILE")]
     record_layer_starts: Option<PathBuf>,
@@ -521,14 +523,16 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         }
         let origin = StartsOrigin {
             stage: stage.name().to_string(),
+            failure,
             scene: SceneKind::Cube.name().to_string(),
             command: format!("{}{record_flags}", command(&results)),
         };
         save_starts(path, &starts, &origin)?;
         let failed = starts.iter().filter(|s| s.failed).count();
         eprintln!(
-            "recorded {} {name} starts (from {failed} of which the policy {failure}) in {}",
+            "recorded {} {name} starts (from {failed} of which the policy {}) in {}",
             starts.len(),
+            failure.describe(),
             path.display()
         );
     }
@@ -787,9 +791,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         None => trained,
     };
     let scene = Scene::load(object.scene())?;
-    let starts = match &args.starts {
-        None => None,
-        Some(path) => Some(starts_for(path, &scene, args.stage)?),
+    let (starts, failure) = match &args.starts {
+        None => (None, args.stage.recorded_failure()),
+        Some(path) => {
+            let (starts, failure) = starts_for(path, &scene, args.stage)?;
+            (Some(starts), failure)
+        }
     };
     let numbered = |starts: &Option<std::sync::Arc<[dexcube_env::RecordedStart]>>| {
         starts.as_ref().map(|starts| StartMix {
@@ -838,11 +845,11 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);
-            // What the recording counted as failing: Stage 1, a drop; Stage 2, anything but
-            // the quarter turn left square.
-            let failed = match args.stage {
-                EnvKind::Rot => ending == Ending::Dropped,
-                EnvKind::Layer => ending != Ending::Success || !trace.square,
+            // What the recording counted as failing.
+            let failed = match failure {
+                RecordedFailure::Dropped => ending == Ending::Dropped,
+                RecordedFailure::DroppedOrMissed => ending != Ending::Success,
+                RecordedFailure::NotSquare => ending != Ending::Success || !trace.square,
             };
             if failed && starts.as_ref().is_some_and(|s| s[k].failed) {
                 failures_again.fetch_add(1, Ordering::Relaxed);
@@ -905,9 +912,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if starts.is_some() {
-        let failure = args.stage.recorded_failure();
         println!(
-            "  starts from which the recorded policy {failure}: {recorded_failures}; this one failed so from {} of them",
+            "  starts from which the recorded policy {}: {recorded_failures}; this one failed so from {} of them",
+            failure.describe(),
             failures_again.into_inner()
         );
     }

@@ -349,7 +349,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let scene = Scene::load(object.scene())?;
     let starts = match &args.starts {
         Some(path) => Some(StartMix {
-            starts: starts_for(path, &scene, args.choice.env)?,
+            starts: starts_for(path, &scene, args.choice.env)?.0,
             pick: StartPick::Share {
                 share: args.start_share,
                 failed_weight: args.failed_weight,

@@ -39,7 +39,7 @@ pub use hand_object::{
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, achieved_goal, pose_goal};
-pub use starts::{RecordedStart, StartMix, StartPick};
+pub use starts::{RecordedFailure, RecordedStart, StartMix, StartPick};
 pub use vec_env::VecEnv;
 
 /// Control steps in an episode (the paper's 100).

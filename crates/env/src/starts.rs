@@ -20,10 +20,53 @@ pub struct RecordedStart {
     /// 7-number pose goal); for Stage 2 the layer angle to turn (+π/2, U'), then the angle
     /// the layer had already turned when the policy took over, which its view counts from.
     pub goal: Vec<f64>,
-    /// Whether the policy that was recorded failed from here, in the way its stage's training
-    /// weights: Stage 1, it dropped the cube; Stage 2, it did not leave the layer turned
-    /// within 0.1 rad of its goal with the cube in its good state (or dropped the cube).
+    /// Whether the policy that was recorded failed from here, in the way its file's
+    /// [`RecordedFailure`] says.
     pub failed: bool,
+}
+
+/// What a file of recorded starts marks as a failure of the policy that was recorded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RecordedFailure {
+    /// Stage 1 as recorded in sessions 13 to 19: the cube dropped (or the physics diverged).
+    Dropped,
+    /// Stage 1 since session 20: the cube dropped, or the stage ended without the pose the
+    /// operator's check after Stage 1 accepts (the paper's pose test in the policy's mode).
+    DroppedOrMissed,
+    /// Stage 2: the layer not left turned within 0.1 rad of the quarter turn with the cube
+    /// in its good state (or the cube dropped).
+    NotSquare,
+}
+
+impl RecordedFailure {
+    /// The name a start file's metadata gives it.
+    pub fn tag(self) -> &'static str {
+        match self {
+            RecordedFailure::Dropped => "dropped",
+            RecordedFailure::DroppedOrMissed => "dropped-or-missed",
+            RecordedFailure::NotSquare => "not-square",
+        }
+    }
+
+    /// The failure a tag names.
+    pub fn from_tag(tag: &str) -> Option<RecordedFailure> {
+        [
+            RecordedFailure::Dropped,
+            RecordedFailure::DroppedOrMissed,
+            RecordedFailure::NotSquare,
+        ]
+        .into_iter()
+        .find(|f| f.tag() == tag)
+    }
+
+    /// What the recorded policy did from a failed start, as a verb phrase.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RecordedFailure::Dropped => "dropped the cube",
+            RecordedFailure::DroppedOrMissed => "dropped the cube or missed the pose",
+            RecordedFailure::NotSquare => "did not leave the layer turned with the cube square",
+        }
+    }
 }
 
 /// Recorded starts, and which of an environment's resets begin from them.

@@ -184,6 +184,7 @@ pub fn run_cube(
             recording = RecordingStage1 {
                 inner: &mut stages.stage1,
                 starts,
+                accepts: &accepts,
             };
             &mut recording
         }

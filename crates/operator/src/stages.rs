@@ -368,11 +368,15 @@ impl Stage2 for PolicyStage2 {
 
 /// A Stage 1 that records where each of its runs hands over to the policy: the physics state
 /// once the hand has opened (after [`OPENING_STEPS`]), the pose asked for, and whether the
-/// run then dropped the cube. A run that dropped the cube while the hand opened records
-/// nothing.
+/// run then failed ([`RecordedFailure::DroppedOrMissed`]: it dropped the cube, or ended
+/// without the pose `accepts`, the operator's check after Stage 1). A run that dropped the
+/// cube while the hand opened records nothing.
+///
+/// [`RecordedFailure::DroppedOrMissed`]: dexcube_env::RecordedFailure::DroppedOrMissed
 pub struct RecordingStage1<'a> {
     pub inner: &'a mut dyn Stage1,
     pub starts: &'a mut Vec<RecordedStart>,
+    pub accepts: &'a (dyn Fn(&Sim, [f64; 3], Quat) -> bool + Sync),
 }
 
 impl Stage1 for RecordingStage1<'_> {
@@ -390,7 +394,7 @@ impl Stage1 for RecordingStage1<'_> {
             self.starts.push(RecordedStart {
                 state,
                 goal: pose_goal(position, target),
-                failed: run.dropped,
+                failed: run.dropped || run.diverged || !(self.accepts)(sim, position, target),
             });
         }
         run

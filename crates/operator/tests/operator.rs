@@ -636,20 +636,24 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
 
 /// A recorded Stage 1 start is where the policy took over, once the hand had opened: a
 /// CubeRotEnv reset from it and run with the same policy for an episode ends exactly where
-/// the operator's Stage 1 did. This is what lets `eval-stage` and training start where the
+/// the operator's Stage 1 did, and the start is marked failed exactly when the run dropped
+/// the cube or ended without the pose the operator's check accepts. This is what lets `eval-stage` and training start where the
 /// operator hands the cube over.
 #[test]
 fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
     let (mut stages, resting, scene, mut sim) = solved_cube_on_a_bent_hand();
     let target = dexcube_operator::stages::stage1_target(Face::R);
     let mut starts = Vec::new();
+    let accepts = pose_reached(RotGoal::paper(stages.stage1.goal.mode));
     let run = RecordingStage1 {
         inner: &mut stages.stage1,
         starts: &mut starts,
+        accepts: &accepts,
     }
     .run(&mut sim, resting, target, &mut |_| {});
     assert_eq!(starts.len(), 1, "one run, one start");
-    assert_eq!(starts[0].failed, run.dropped);
+    let posed = accepts(&sim, resting, target);
+    assert_eq!(starts[0].failed, run.dropped || !posed);
     assert_eq!(run.steps, OPENING_STEPS + EPISODE_STEPS);
 
     let mix = StartMix {
@@ -660,6 +664,49 @@ fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
     replay(&mut env, &stages.stage1.policy);
     assert_eq!(env.sim().object_pose(), sim.object_pose());
     assert_eq!(env.sim().hand_angles(), sim.hand_angles());
+}
+
+/// A Stage 1 that runs the physics through the hand's opening and then sets the cube down
+/// with U up at the position asked for, whatever pose was asked for.
+struct UUpStage1;
+
+impl Stage1 for UUpStage1 {
+    fn run(&mut self, sim: &mut Sim, position: [f64; 3], _: Quat, watch: Watch) -> StageRun {
+        for _ in 0..OPENING_STEPS {
+            sim.step().unwrap();
+            watch(sim);
+        }
+        let up = dexcube_operator::stages::stage1_target(Face::U);
+        KinematicStage1.run(sim, position, up, watch);
+        StageRun {
+            steps: OPENING_STEPS + 1,
+            ..StageRun::default()
+        }
+    }
+}
+
+/// A Stage 1 run that keeps the cube but ends without the pose the operator's check accepts
+/// is recorded as failed; one that ends with it, as not.
+#[test]
+fn a_stage_1_start_is_marked_failed_when_the_pose_is_missed() {
+    let scene = Scene::load(SceneKind::Cube).unwrap();
+    let accepts = pose_reached(RotGoal::paper(RotMode::Pair));
+    // Asking for U up is met; asking for R up is not.
+    for (face, missed) in [(Face::U, false), (Face::R, true)] {
+        let mut sim = Sim::new(scene.clone());
+        set_up_scramble(&mut sim, &[], RESTING);
+        let mut starts = Vec::new();
+        let target = dexcube_operator::stages::stage1_target(face);
+        let run = RecordingStage1 {
+            inner: &mut UUpStage1,
+            starts: &mut starts,
+            accepts: &accepts,
+        }
+        .run(&mut sim, RESTING, target, &mut |_| {});
+        assert!(!run.dropped, "{face:?}");
+        assert_eq!(starts.len(), 1, "{face:?}");
+        assert_eq!(starts[0].failed, missed, "{face:?}");
+    }
 }
 
 /// The shipped stages, and a solved cube resting on the palm of a hand whose targets are

@@ -1,14 +1,16 @@
 //! Recorded starts of a stage ([`RecordedStart`]) on disk: one safetensors file of float64
 //! tensors, `state` (starts × state size), `goal` (starts × goal size: 7 for Stage 1's pose,
-//! 2 for Stage 2's angle and the angle already turned) and `failed` (starts), with the stage, the scene and the command
-//! that recorded them in its metadata. Written atomically, and checked on loading, like a
-//! checkpoint. Files from before Stage 2 starts (sessions 13 to 18) name the goal
-//! `pose_goal` and the failures `dropped`, hold Stage 1's, and are read as such.
+//! 2 for Stage 2's angle and the angle already turned) and `failed` (starts), with the
+//! stage, what `failed` marks, the scene and the command that recorded them in its metadata.
+//! Written atomically, and checked on loading, like a checkpoint. Files from before Stage 2
+//! starts (sessions 13 to 18) name the goal `pose_goal` and the failures `dropped`, hold
+//! Stage 1's, and are read as such; files without a `failure` entry (before session 20) mark
+//! Stage 1's drops only.
 
 use std::collections::HashMap;
 use std::path::Path;
 
-use dexcube_env::RecordedStart;
+use dexcube_env::{RecordedFailure, RecordedStart};
 use safetensors::tensor::Dtype;
 
 use crate::checkpoint::{CheckpointError, RawTensor, write_safetensors};
@@ -18,6 +20,8 @@ use crate::checkpoint::{CheckpointError, RawTensor, write_safetensors};
 pub struct StartsOrigin {
     /// The stage whose starts they are: "rot" (Stage 1) or "layer" (Stage 2).
     pub stage: String,
+    /// What a start's `failed` mark means.
+    pub failure: RecordedFailure,
     /// The scene the states belong to ("cube").
     pub scene: String,
     /// The command that recorded them.
@@ -73,6 +77,7 @@ pub fn save_starts(
     ];
     let metadata = HashMap::from([
         ("stage".to_string(), origin.stage.clone()),
+        ("failure".to_string(), origin.failure.tag().to_string()),
         ("scene".to_string(), origin.scene.clone()),
         ("command".to_string(), origin.command.clone()),
     ]);
@@ -126,11 +131,19 @@ pub fn load_starts(path: &Path) -> Result<(Vec<RecordedStart>, StartsOrigin), Ch
     }
     let metadata = header.metadata().clone().unwrap_or_default();
     let field = |key: &str| metadata.get(key).cloned().unwrap_or_default();
+    let stage = metadata
+        .get("stage")
+        .cloned()
+        .unwrap_or_else(|| "rot".into());
+    let failure = match metadata.get("failure") {
+        Some(tag) => RecordedFailure::from_tag(tag)
+            .ok_or_else(|| corrupt(format!("unknown failure mark '{tag}' in its metadata")))?,
+        None if stage == "rot" => RecordedFailure::Dropped,
+        None => RecordedFailure::NotSquare,
+    };
     let origin = StartsOrigin {
-        stage: metadata
-            .get("stage")
-            .cloned()
-            .unwrap_or_else(|| "rot".into()),
+        stage,
+        failure,
         scene: field("scene"),
         command: field("command"),
     };
@@ -161,6 +174,7 @@ mod tests {
             .collect();
         let origin = StartsOrigin {
             stage: "rot".into(),
+            failure: RecordedFailure::DroppedOrMissed,
             scene: "cube".into(),
             command: "dexcube eval --record-starts x".into(),
         };
@@ -182,7 +196,8 @@ mod tests {
     }
 
     /// The files sessions 13 to 18 recorded (goal named `pose_goal`, failures `dropped`, no
-    /// stage) read as Stage 1's, with their drops as the failures.
+    /// stage) read as Stage 1's, with their drops as the failures; session 19's, with a stage
+    /// but no failure mark, read as marking drops for Stage 1 and the square test for Stage 2.
     #[test]
     fn a_file_from_before_stage_2_starts_reads_as_stage_1s() {
         let committed = concat!(
@@ -191,10 +206,26 @@ mod tests {
         );
         let (starts, origin) = load_starts(Path::new(committed)).expect("loaded");
         assert_eq!(origin.stage, "rot");
+        assert_eq!(origin.failure, RecordedFailure::Dropped);
         assert_eq!(origin.scene, "cube");
         assert_eq!(starts.len(), 1254);
         assert!(starts.iter().all(|s| s.goal.len() == 7));
         // The policy that recorded them (session 13's Stage 1) dropped the cube from 19.
         assert_eq!(starts.iter().filter(|s| s.failed).count(), 19);
+
+        let session_19 = |name: &str| {
+            let path = format!("{}/../../results/starts/{name}", env!("CARGO_MANIFEST_DIR"));
+            let (starts, origin) = load_starts(Path::new(&path)).expect("loaded");
+            let failed = starts.iter().filter(|s| s.failed).count();
+            (origin.stage, origin.failure, starts.len(), failed)
+        };
+        assert_eq!(
+            session_19("starts2-select-seed2.safetensors"),
+            ("rot".into(), RecordedFailure::Dropped, 1200, 6)
+        );
+        assert_eq!(
+            session_19("layer-starts-select-seed2.safetensors"),
+            ("layer".into(), RecordedFailure::NotSquare, 1854, 124)
+        );
     }
 }
