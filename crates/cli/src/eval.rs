@@ -12,8 +12,8 @@ use clap::Args;
 use dexcube_cube::{CostTable, DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RotGoal,
-    RotMode, SimulatedEnv, StartMix, StartPick, is_square,
+    CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RecordedStart,
+    RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, is_square,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
@@ -650,6 +650,12 @@ pub struct EvalStageArgs {
     /// min(--episodes, starts) of them.
     #[arg(long, value_name = "FILE")]
     starts: Option<PathBuf>,
+    /// Also record where every episode began (the physics state after its fresh reset, and
+    /// its goal) into this file, each marked failed as `eval` marks the stage's starts, for
+    /// `train --starts`: training can then draw the placements this policy failed from more
+    /// often. Record with seeds that no evaluation uses.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["starts", "record"])]
+    record_starts: Option<PathBuf>,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -737,16 +743,20 @@ struct EpisodeTrace {
     info: Info,
     square: bool,
     longest_hold: usize,
+    /// Where the episode began, when asked for (a fresh reset's).
+    start: Option<RecordedStart>,
 }
 
-/// Runs a deterministic episode from `seed`.
+/// Runs a deterministic episode from `seed`, keeping where it began if `record`.
 fn episode(
     env: &mut dyn SimulatedEnv,
     policy: &Policy,
     seed: u64,
     thresholds: (f64, f64),
+    record: bool,
 ) -> EpisodeTrace {
     let (mut obs, _) = env.reset(Some(seed));
+    let start = record.then(|| env.fresh_start());
     let (mut hold, mut longest_hold) = (0, 0);
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
@@ -761,6 +771,7 @@ fn episode(
                 square: is_square(env.sim()),
                 info: t.info,
                 longest_hold,
+                start,
             };
         }
         obs = t.observation;
@@ -812,6 +823,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         s[..episodes].iter().filter(|start| start.failed).count()
     });
     let failures_again = AtomicUsize::new(0);
+    let recorded = std::sync::Mutex::new(Vec::new());
     let bar = ProgressBar::new(episodes as u64);
     in_parallel(
         args.threads,
@@ -841,7 +853,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 Some(_) => k as u64,
                 None => args.seed + k as u64,
             };
-            let trace = episode(env.as_mut(), policy, seed, thresholds);
+            let record = args.record_starts.is_some();
+            let trace = episode(env.as_mut(), policy, seed, thresholds, record);
             let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);
@@ -853,6 +866,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             };
             if failed && starts.as_ref().is_some_and(|s| s[k].failed) {
                 failures_again.fetch_add(1, Ordering::Relaxed);
+            }
+            if let Some(start) = trace.start {
+                let start = RecordedStart { failed, ..start };
+                recorded.lock().expect("no thread panics").push((k, start));
             }
             if ending == Ending::Success && !trace.square {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
@@ -918,6 +935,29 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             failures_again.into_inner()
         );
     }
+    if let Some(path) = &args.record_starts {
+        let mut recorded = recorded.into_inner().expect("no thread panics");
+        recorded.sort_by_key(|(k, _)| *k);
+        let starts: Vec<_> = recorded.into_iter().map(|(_, start)| start).collect();
+        let origin = StartsOrigin {
+            stage: args.stage.name().to_string(),
+            failure,
+            scene: object.scene().name().to_string(),
+            command: format!(
+                "{} --record-starts {}",
+                stage_command(&args, object, &prefix),
+                path.display()
+            ),
+        };
+        save_starts(path, &starts, &origin)?;
+        let failed = starts.iter().filter(|s| s.failed).count();
+        println!(
+            "  recorded the {} starts (from {failed} of which this policy {}) in {}",
+            starts.len(),
+            failure.describe(),
+            path.display()
+        );
+    }
     if args.record {
         let wins = (wins, wins - wins_out_of_square);
         record(&prefix, &args, (object, object == trained), wins, (lo, hi))?;
@@ -964,17 +1004,22 @@ fn record(
         "ci95": [lo, hi],
         "successes_left_square": square_successes,
         "seed": args.seed,
-        "command": format!(
-            "dexcube eval-stage {stage} --object {} --episodes {} --seed {} --{stage}-policy {}",
-            object.name(),
-            args.episodes,
-            args.seed,
-            prefix.display(),
-            stage = args.stage.name(),
-        ),
+        "command": stage_command(args, object, prefix),
     });
     write_atomically(&path, serde_json::to_string_pretty(&card)?.as_bytes())?;
     Ok(())
+}
+
+/// The `eval-stage` command that runs these episodes of the policy at `prefix` on `object`.
+fn stage_command(args: &EvalStageArgs, object: ObjectKind, prefix: &Path) -> String {
+    format!(
+        "dexcube eval-stage {stage} --object {} --episodes {} --seed {} --{stage}-policy {}",
+        object.name(),
+        args.episodes,
+        args.seed,
+        prefix.display(),
+        stage = args.stage.name(),
+    )
 }
 
 #[cfg(test)]

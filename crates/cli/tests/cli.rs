@@ -241,6 +241,64 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     assert!(md.contains("--seed 5 --rot-policy"), "{md}");
 }
 
+/// `eval-stage --record-starts` keeps where each fresh episode began, marked failed as the
+/// stage's starts are; running the same policy from that file replays every episode: the
+/// same successes, and a failure from exactly the starts marked failed.
+#[test]
+fn eval_stage_records_fresh_starts_that_replay_its_episodes() {
+    let dir = std::env::temp_dir().join("dexcube-cli-fresh-starts");
+    let _ = std::fs::remove_dir_all(&dir);
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let policies = [
+        "--rot-policy",
+        rot.to_str().unwrap(),
+        "--layer-policy",
+        layer.to_str().unwrap(),
+    ];
+    for stage in ["rot", "layer"] {
+        let file = dir.join(format!("{stage}.safetensors"));
+        let run = |source: &[&str]| {
+            let o = dexcube(
+                &[
+                    &["eval-stage", stage, "--episodes", "6", "--threads", "2"][..],
+                    &policies,
+                    source,
+                ]
+                .concat(),
+                "",
+            );
+            assert!(o.status.success(), "{}", stderr(&o));
+            stdout(&o)
+        };
+        let fresh = run(&[
+            "--seed",
+            "1000000",
+            "--record-starts",
+            file.to_str().unwrap(),
+        ]);
+        // The number written just before `marker`.
+        let number_before = |text: &str, marker: &str| -> usize {
+            let head = &text[..text.find(marker).unwrap_or_else(|| panic!("{text}"))];
+            let digits = head.len() - head.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+            head[head.len() - digits..].parse().unwrap()
+        };
+        let wins = number_before(&fresh, "/6 = ");
+        let failed = number_before(&fresh, " of which this policy");
+        let replayed = run(&["--starts", file.to_str().unwrap()]);
+        assert_eq!(
+            number_before(&replayed, "/6 = "),
+            wins,
+            "{fresh}\n{replayed}"
+        );
+        assert!(
+            replayed.contains(&format!(
+                ": {failed}; this one failed so from {failed} of them"
+            )),
+            "{fresh}\n{replayed}"
+        );
+    }
+}
+
 /// `eval --record-starts` keeps where each Stage 1 run began, `--record-layer-starts` where
 /// each Stage 2 run began, and `eval-stage rot|layer --starts` runs the policy from them; a
 /// file that holds no starts, or another stage's, is refused.
@@ -329,7 +387,9 @@ fn eval_records_stage_starts_that_eval_stage_runs_from() {
         said.contains(&format!("/{runs} = ")) && said.contains("from the recorded starts in"),
         "{said}"
     );
-    assert!(said.contains("starts from which the recorded policy dropped the cube"));
+    assert!(
+        said.contains("starts from which the recorded policy dropped the cube or missed the pose")
+    );
     let o = from(&layer_starts, "layer");
     assert!(o.status.success(), "{}", stderr(&o));
     let said = stdout(&o);

@@ -388,6 +388,16 @@ impl SimulatedEnv for LayerOpEnv {
     fn sim_mut(&mut self) -> &mut dexcube_sim::Sim {
         &mut self.hand.sim
     }
+
+    /// The goal holds the quarter turn asked for and no angle already turned: a fresh
+    /// reset counts the layer from where it lies.
+    fn fresh_start(&self) -> RecordedStart {
+        RecordedStart {
+            state: self.hand.sim.physics_state(),
+            goal: vec![self.desired, 0.0],
+            failed: false,
+        }
+    }
 }
 
 impl GoalEnv for LayerOpEnv {

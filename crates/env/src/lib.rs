@@ -105,4 +105,10 @@ pub trait GoalEnv: Send {
 pub trait SimulatedEnv: GoalEnv {
     fn sim(&self) -> &dexcube_sim::Sim;
     fn sim_mut(&mut self) -> &mut dexcube_sim::Sim;
+
+    /// Called right after a fresh reset (one not from a recorded start): the start that
+    /// `reset_from` restores this episode from, bit for bit (its physics state and goal; not
+    /// marked failed). `eval-stage --record-starts` keeps them, so that training can draw
+    /// again the fresh placements a policy failed from.
+    fn fresh_start(&self) -> RecordedStart;
 }

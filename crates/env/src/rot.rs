@@ -169,6 +169,14 @@ impl SimulatedEnv for CubeRotEnv {
     fn sim_mut(&mut self) -> &mut dexcube_sim::Sim {
         &mut self.hand.sim
     }
+
+    fn fresh_start(&self) -> RecordedStart {
+        RecordedStart {
+            state: self.hand.sim.physics_state(),
+            goal: self.desired.clone(),
+            failed: false,
+        }
+    }
 }
 
 impl GoalEnv for CubeRotEnv {
