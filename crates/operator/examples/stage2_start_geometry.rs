@@ -1,0 +1,93 @@
+//! Where Stage 2's failures start from: for recorded Stage 2 starts (`dexcube eval-stage layer
+//! --record-starts`, or `dexcube eval --record-layer-starts`), how many starts, and how many
+//! of them the recorded policy failed from, by the cube's yaw on the palm (how far its side
+//! faces turn from square to the hand's axes, 0 to 45 degrees, a cube's sides repeating every
+//! 90), by how far it sits from the palm's resting point across the palm, and by which side
+//! of that point it sits (the fingertips lie towards -x).
+//!
+//! `cargo run --release -p dexcube-operator --example stage2_start_geometry -- STARTS...`
+
+use std::path::Path;
+
+use dexcube_cube::Face;
+use dexcube_env::layer::{LayerGoals, LayerMove};
+use dexcube_env::{LayerOpEnv, SimulatedEnv};
+use dexcube_sim::cube::face_normal;
+use dexcube_sim::rotation::rotate;
+use dexcube_sim::{Scene, SceneKind, Sim};
+
+const YAW_BINS: [(f64, f64); 5] = [
+    (0.0, 5.0),
+    (5.0, 15.0),
+    (15.0, 25.0),
+    (25.0, 35.0),
+    (35.0, 45.1),
+];
+/// Millimetres from the resting point, across the palm.
+const OFFSET_BINS: [(f64, f64); 4] = [(0.0, 3.0), (3.0, 6.0), (6.0, 10.0), (10.0, 100.0)];
+
+/// One start: the cube's yaw from square in degrees, its offset across the palm from the
+/// resting point in millimetres (x, y), and whether the recorded policy failed from there.
+struct Start {
+    yaw: f64,
+    offset: [f64; 2],
+    failed: bool,
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let paths: Vec<String> = std::env::args().skip(1).collect();
+    if paths.is_empty() {
+        return Err("usage: stage2_start_geometry STARTS...".into());
+    }
+    let scene = Scene::load(SceneKind::Cube)?;
+    let resting = dexcube_env::resting_point(&mut Sim::new(scene.clone()));
+    let mut env = LayerOpEnv::with_scene(scene, LayerMove::UPrime, LayerGoals::Evaluation);
+    let mut starts = Vec::new();
+    for path in &paths {
+        let (recorded, _) = dexcube_rl::start_file::load_starts(Path::new(path))?;
+        for start in &recorded {
+            env.reset_from(start)?;
+            let pose = env.sim().object_pose();
+            // The side face whose normal lies most nearly level gives the yaw.
+            let side = [Face::R, Face::B, Face::U]
+                .map(|face| rotate(&pose.orientation, face_normal(face)))
+                .into_iter()
+                .min_by(|a, b| a[2].abs().total_cmp(&b[2].abs()))
+                .expect("three faces");
+            let yaw = side[1].atan2(side[0]).to_degrees().rem_euclid(90.0);
+            starts.push(Start {
+                yaw: yaw.min(90.0 - yaw),
+                offset: [0, 1].map(|k| 1000.0 * (pose.position[k] - resting[k])),
+                failed: start.failed,
+            });
+        }
+    }
+    let count = |chosen: &dyn Fn(&Start) -> bool| {
+        let chosen: Vec<&Start> = starts.iter().filter(|s| chosen(s)).collect();
+        let failed = chosen.iter().filter(|s| s.failed).count();
+        let rate = 100.0 * failed as f64 / chosen.len().max(1) as f64;
+        format!("{} starts, {failed} failed ({rate:.1}%)", chosen.len())
+    };
+    println!("{} starts from {}", starts.len(), paths.join(", "));
+    println!("by the cube's yaw from square to the hand:");
+    for (low, high) in YAW_BINS {
+        let yawed = count(&|s| (low..high).contains(&s.yaw));
+        println!("  {low:>2.0} to {high:>2.0} degrees: {yawed}");
+    }
+    println!("by the distance from the resting point across the palm:");
+    for (low, high) in OFFSET_BINS {
+        let off = count(&|s| (low..high).contains(&s.offset[0].hypot(s.offset[1])));
+        println!("  {low:>2.0} to {high:>3.0} mm: {off}");
+    }
+    println!("by the side of the resting point (x towards the wrist, y across the palm):");
+    for (name, side) in [
+        ("x < 0 (towards the fingertips)", [-1.0, 0.0]),
+        ("x > 0 (towards the wrist)", [1.0, 0.0]),
+        ("y < 0", [0.0, -1.0]),
+        ("y > 0", [0.0, 1.0]),
+    ] {
+        let on_side = count(&|s| s.offset[0] * side[0] + s.offset[1] * side[1] > 0.0);
+        println!("  {name}: {on_side}");
+    }
+    Ok(())
+}
