@@ -654,7 +654,7 @@ pub struct EvalStageArgs {
     /// its goal) into this file, each marked failed as `eval` marks the stage's starts, for
     /// `train --starts`: training can then draw the placements this policy failed from more
     /// often. Record with seeds that no evaluation uses.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["starts", "record"])]
+    #[arg(long, value_name = "FILE", conflicts_with = "starts")]
     record_starts: Option<PathBuf>,
 }
 
