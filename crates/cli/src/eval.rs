@@ -809,7 +809,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             (Some(starts), failure)
         }
     };
-    let numbered = |starts: &Option<std::sync::Arc<[dexcube_env::RecordedStart]>>| {
+    let numbered = |starts: &Option<std::sync::Arc<[RecordedStart]>>| {
         starts.as_ref().map(|starts| StartMix {
             starts: starts.clone(),
             pick: StartPick::Numbered,
