@@ -823,7 +823,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         s[..episodes].iter().filter(|start| start.failed).count()
     });
     let failures_again = AtomicUsize::new(0);
-    let recorded = std::sync::Mutex::new(Vec::new());
+    let (keep_starts, recorded) = (
+        args.record_starts.is_some(),
+        std::sync::Mutex::new(Vec::new()),
+    );
     let bar = ProgressBar::new(episodes as u64);
     in_parallel(
         args.threads,
@@ -853,8 +856,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 Some(_) => k as u64,
                 None => args.seed + k as u64,
             };
-            let record = args.record_starts.is_some();
-            let trace = episode(env.as_mut(), policy, seed, thresholds, record);
+            let trace = episode(env.as_mut(), policy, seed, thresholds, keep_starts);
             let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);

@@ -124,6 +124,17 @@ fn models() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
 }
 
+/// The flags that point a command at the shipped policies.
+fn shipped_policy_flags() -> [String; 4] {
+    let path = |name: &str| models().join(name).to_str().unwrap().to_string();
+    [
+        "--rot-policy".into(),
+        path("rot"),
+        "--layer-policy".into(),
+        path("layer"),
+    ]
+}
+
 #[test]
 fn demo_narrates_the_hand_solving_with_the_shipped_policies() {
     let (rot, layer) = (models().join("rot"), models().join("layer"));
@@ -248,13 +259,8 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
 fn eval_stage_records_fresh_starts_that_replay_its_episodes() {
     let dir = std::env::temp_dir().join("dexcube-cli-fresh-starts");
     let _ = std::fs::remove_dir_all(&dir);
-    let (rot, layer) = (models().join("rot"), models().join("layer"));
-    let policies = [
-        "--rot-policy",
-        rot.to_str().unwrap(),
-        "--layer-policy",
-        layer.to_str().unwrap(),
-    ];
+    let flags = shipped_policy_flags();
+    let policies = flags.each_ref().map(String::as_str);
     for stage in ["rot", "layer"] {
         let file = dir.join(format!("{stage}.safetensors"));
         let run = |source: &[&str]| {
@@ -308,13 +314,8 @@ fn eval_records_stage_starts_that_eval_stage_runs_from() {
     let _ = std::fs::remove_dir_all(&dir);
     let starts = dir.join("starts.safetensors");
     let layer_starts = dir.join("layer-starts.safetensors");
-    let (rot, layer) = (models().join("rot"), models().join("layer"));
-    let policies = [
-        "--rot-policy",
-        rot.to_str().unwrap(),
-        "--layer-policy",
-        layer.to_str().unwrap(),
-    ];
+    let flags = shipped_policy_flags();
+    let policies = flags.each_ref().map(String::as_str);
     let o = dexcube(
         &[
             &[
