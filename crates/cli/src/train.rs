@@ -86,6 +86,11 @@ pub struct TrainArgs {
     /// Train without Hindsight Experience Replay (plain DDPG), for ablations.
     #[arg(long)]
     no_her: bool,
+    /// Train with TD3's critics instead of DDPG's (Fujimoto et al. 2018: twin critics, target
+    /// policy smoothing, the actor updated every second step), HER and the rest unchanged. A
+    /// resume must say it again.
+    #[arg(long)]
+    td3: bool,
     /// On the physical cube: begin a share of episodes (--start-share) from the starts
     /// recorded in this file, where the operator hands the cube over, rather than from a fresh
     /// placement: Stage 1's (`dexcube eval --record-starts`) for rot, Stage 2's (`dexcube eval
@@ -277,7 +282,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         same_starts_as_begun(&out, &args)?;
     }
     let published = DdpgHerConfig::default();
-    let config = DdpgHerConfig {
+    let mut config = DdpgHerConfig {
         batches_per_cycle: args.batches,
         her: !args.no_her,
         noise_eps: args.noise_eps.unwrap_or(published.noise_eps),
@@ -286,6 +291,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         anchor: args.anchor,
         ..published
     };
+    if args.td3 {
+        config = config.with_td3();
+    }
     if !(config.actor_lr > 0.0 && config.actor_lr.is_finite()) {
         bail!(
             "--actor-lr must be a positive number, not {}",

@@ -667,8 +667,8 @@ fn eval_stage_records_each_object_under_its_own_name() {
     );
 }
 
-/// `plot` draws committed runs as one curve per environment with a CSV of the figures, and
-/// refuses a seed given twice or several runs without a figure to draw them into.
+/// `plot` draws committed runs as one curve per environment (and learner) with a CSV of the
+/// figures, and refuses a seed given twice or several runs without a figure to draw them into.
 #[test]
 fn plot_draws_runs_across_seeds_and_refuses_a_seed_twice() {
     let training = concat!(env!("CARGO_MANIFEST_DIR"), "/../../results/training/");
@@ -731,9 +731,23 @@ fn plot_draws_runs_across_seeds_and_refuses_a_seed_twice() {
     };
     let o = plot_beside_rot(&state);
     assert!(o.status.success(), "{}", stderr(&o));
+    let anchor = state["config"]["anchor"].clone();
     state["config"]["anchor"] = 5.0.into();
     let o = plot_beside_rot(&state);
     assert_clean_failure(&o, 2, "with different hyperparameters");
+    // With TD3's critics it is another learner's run: its own curve beside DDPG's.
+    state["config"]["anchor"] = anchor;
+    state["config"]["twin_critics"] = true.into();
+    let o = plot_beside_rot(&state);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(out.with_extension("csv")).unwrap();
+    assert!(
+        csv.lines().any(|r| r.contains("(TD3)\""))
+            && csv
+                .lines()
+                .any(|r| !r.contains("TD3") && r.contains("CubeRotEnv")),
+        "{csv}"
+    );
     let o = dexcube(&["plot", &rot, &layer], "");
     assert_clean_failure(&o, 2, "pass --out PNG");
     let o = dexcube(

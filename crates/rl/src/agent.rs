@@ -15,11 +15,16 @@
 //!
 //! both gradients taken from the same forward pass, as baselines does. Target networks live
 //! on the plain (non-autodiff) device, so their updates can never grow an autodiff graph.
+//!
+//! With TD3's options (`DdpgHerConfig::with_td3`; Fujimoto et al. 2018) a second critic learns
+//! beside the first on the same targets, y takes the smaller of the two target critics' values
+//! at a target action smoothed by clipped Gaussian noise, and the actor (still along the first
+//! critic) learns on every `policy_delay`-th step only.
 
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::prelude::*;
 use burn::tensor::TensorData;
-use rand::Rng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::config::DdpgHerConfig;
@@ -77,6 +82,13 @@ struct Anchor {
     goal_norm: Normalizer,
 }
 
+/// TD3's second critic, with its target and optimiser.
+struct TwinCritic {
+    critic: Mlp,
+    target: Mlp,
+    optimizer: ModuleOptimizer,
+}
+
 /// What one optimisation step measured.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StepStats {
@@ -100,6 +112,12 @@ pub struct Agent {
     anchor: Option<Anchor>,
     actor_optimizer: ModuleOptimizer,
     critic_optimizer: ModuleOptimizer,
+    /// The second critic, when `config.twin_critics`.
+    twin: Option<TwinCritic>,
+    /// Optimisation steps taken, which time the actor's delayed updates.
+    steps: usize,
+    /// Draws the target policy smoothing noise.
+    smoothing_rng: ChaCha8Rng,
     pub observation_norm: Normalizer,
     pub goal_norm: Normalizer,
 }
@@ -114,6 +132,15 @@ impl Agent {
         let input = dims.observation + dims.goal;
         let actor = Mlp::new(input, &config.hidden, dims.action, &autodiff);
         let critic = Mlp::new(input + dims.action, &config.hidden, 1, &autodiff);
+        // Made after the others, so that DDPG's initial weights do not depend on TD3's option.
+        let twin = config.twin_critics.then(|| {
+            let critic = Mlp::new(input + dims.action, &config.hidden, 1, &autodiff);
+            TwinCritic {
+                target: critic.valid(),
+                critic,
+                optimizer: AdamConfig::new().init(),
+            }
+        });
         let normalizer =
             |size| Normalizer::new(size, config.norm_eps, config.norm_clip, config.clip_obs);
         Agent {
@@ -125,6 +152,9 @@ impl Agent {
             critic,
             actor_optimizer: AdamConfig::new().init(),
             critic_optimizer: AdamConfig::new().init(),
+            twin,
+            steps: 0,
+            smoothing_rng: ChaCha8Rng::seed_from_u64(seed ^ 0x7D3_5EED),
             observation_norm: normalizer(dims.observation),
             goal_norm: normalizer(dims.goal),
             config,
@@ -184,15 +214,36 @@ impl Agent {
         actions
     }
 
+    /// TD3's target policy smoothing noise for `n` target actions: Gaussian of
+    /// `target_noise`, clipped to ±`target_noise_clip`; `None` without smoothing.
+    fn smoothing_noise(&mut self, n: usize) -> Option<Tensor<2>> {
+        let (sigma, clip) = (self.config.target_noise, self.config.target_noise_clip);
+        if sigma <= 0.0 {
+            return None;
+        }
+        let noise: Vec<f32> = (0..n * self.dims.action)
+            .map(|_| (sigma * standard_normal(&mut self.smoothing_rng)).clamp(-clip, clip) as f32)
+            .collect();
+        Some(Tensor::from_data(
+            TensorData::new(noise, [n, self.dims.action]),
+            &self.plain,
+        ))
+    }
+
     /// The critic's regression targets y for `batch`, `[n, 1]` on the plain device, where no
-    /// gradient can reach them.
-    fn targets(&self, batch: &Batch) -> Tensor<2> {
+    /// gradient can reach them; `smoothing` is added to the target actions.
+    fn targets(&self, batch: &Batch, smoothing: Option<Tensor<2>>) -> Tensor<2> {
         let n = batch.len;
         let x_next = self.inputs(&batch.next_observation, &batch.goal, n, &self.plain);
-        let next_action = self.target_actor.forward(x_next.clone()).tanh();
-        let next_q = self
-            .target_critic
-            .forward(Tensor::cat(vec![x_next, next_action], 1));
+        let mut next_action = self.target_actor.forward(x_next.clone()).tanh();
+        if let Some(noise) = smoothing {
+            next_action = (next_action + noise).clamp(-1.0, 1.0);
+        }
+        let next_input = Tensor::cat(vec![x_next, next_action], 1);
+        let mut next_q = self.target_critic.forward(next_input.clone());
+        if let Some(twin) = &self.twin {
+            next_q = next_q.min_pair(twin.target.forward(next_input));
+        }
         let column = |values: &[f32]| -> Tensor<2> {
             Tensor::from_data(TensorData::new(values.to_vec(), [n, 1]), &self.plain)
         };
@@ -203,9 +254,10 @@ impl Agent {
         (bootstrapped * (terminal.neg() + 1.0) + failed).clamp(-floor, 0.0)
     }
 
-    /// The critic's targets for `batch` as numbers, for tests and diagnostics.
+    /// The critic's targets for `batch` as numbers (without smoothing noise), for tests and
+    /// diagnostics.
     pub fn td_targets(&self, batch: &Batch) -> Vec<f32> {
-        self.targets(batch)
+        self.targets(batch, None)
             .into_data()
             .convert::<f32>()
             .try_to_vec::<f32>()
@@ -216,12 +268,22 @@ impl Agent {
     /// holds it.
     pub fn train(&mut self, batch: &Batch, learners: Learners) -> StepStats {
         let (n, da) = (batch.len, self.dims.action);
-        let target: Tensor<2> = Tensor::from_data(self.targets(batch).into_data(), &self.device);
+        let smoothing = self.smoothing_noise(n);
+        let target: Tensor<2> =
+            Tensor::from_data(self.targets(batch, smoothing).into_data(), &self.device);
         let x = self.inputs(&batch.observation, &batch.goal, n, &self.device);
         let action: Tensor<2> =
             Tensor::from_data(TensorData::new(batch.action.clone(), [n, da]), &self.device);
-        let q = self.critic.forward(Tensor::cat(vec![x.clone(), action], 1));
-        let critic_loss = (q.clone() - target).powi_scalar(2).mean();
+        let taken = Tensor::cat(vec![x.clone(), action], 1);
+        let q = self.critic.forward(taken.clone());
+        let critic_loss = (q.clone() - target.clone()).powi_scalar(2).mean();
+        if let Some(twin) = self.twin.as_mut() {
+            let loss = (twin.critic.forward(taken) - target).powi_scalar(2).mean();
+            let grads = GradientsParams::from_grads(loss.backward(), &twin.critic);
+            twin.critic = twin
+                .optimizer
+                .step(self.config.critic_lr, twin.critic.clone(), grads);
+        }
         let pi = self.actor.forward(x.clone()).tanh();
         let q_pi = self.critic.forward(Tensor::cat(vec![x, pi.clone()], 1));
         let mut actor_loss =
@@ -249,7 +311,10 @@ impl Agent {
         self.critic =
             self.critic_optimizer
                 .step(self.config.critic_lr, self.critic.clone(), critic_grads);
-        if learners == Learners::ActorAndCritic {
+        self.steps += 1;
+        let actor_learns = learners == Learners::ActorAndCritic
+            && self.steps.is_multiple_of(self.config.policy_delay.max(1));
+        if actor_learns {
             let actor_grads = GradientsParams::from_grads(actor_loss.backward(), &self.actor);
             self.actor =
                 self.actor_optimizer
@@ -275,6 +340,10 @@ impl Agent {
             params::write(self.target_actor.clone(), &online_actor, blend).expect("same layout");
         self.target_critic =
             params::write(self.target_critic.clone(), &online_critic, blend).expect("same layout");
+        if let Some(twin) = self.twin.as_mut() {
+            let online = params::read(&twin.critic.valid());
+            twin.target = params::write(twin.target.clone(), &online, blend).expect("same layout");
+        }
     }
 
     /// True when no target-network parameter requires a gradient (they live on the plain
@@ -289,6 +358,9 @@ impl Agent {
         let mut any = AnyGrad(false);
         self.target_actor.visit(&mut any);
         self.target_critic.visit(&mut any);
+        if let Some(twin) = &self.twin {
+            twin.target.visit(&mut any);
+        }
         !any.0
     }
 
@@ -348,6 +420,30 @@ impl Agent {
         self.target_actor = params::write(self.target_actor.clone(), &saved[2], replace)?;
         self.target_critic = params::write(self.target_critic.clone(), &saved[3], replace)?;
         self.policy = self.actor.valid();
+        Ok(())
+    }
+
+    /// TD3's second critic and its target, as a checkpoint saves them; `None` in DDPG.
+    pub fn twin_networks(&self) -> Option<[Vec<params::NamedTensor>; 2]> {
+        self.twin.as_ref().map(|twin| {
+            [
+                params::read(&twin.critic.valid()),
+                params::read(&twin.target),
+            ]
+        })
+    }
+
+    /// Loads the second critic and its target saved by `twin_networks`; refuses in DDPG.
+    pub fn load_twin_networks(
+        &mut self,
+        saved: &[Vec<params::NamedTensor>; 2],
+    ) -> Result<(), params::ParamMismatch> {
+        let replace = |_: &[f32], given: &[f32]| given.to_vec();
+        let twin = self.twin.as_mut().ok_or_else(|| {
+            params::ParamMismatch::Missing("a second critic in this agent (DDPG has one)".into())
+        })?;
+        twin.critic = params::write(twin.critic.clone(), &saved[0], replace)?.train();
+        twin.target = params::write(twin.target.clone(), &saved[1], replace)?;
         Ok(())
     }
 }

@@ -1,6 +1,7 @@
 //! Every DDPG + HER hyperparameter in one struct. The defaults are those of the HER baselines
 //! (Andrychowicz et al., "Hindsight Experience Replay", NeurIPS 2017; OpenAI baselines,
-//! `her/experiment/config.py`, `DEFAULT_PARAMS`), which Li et al. trained with.
+//! `her/experiment/config.py`, `DEFAULT_PARAMS`), which Li et al. trained with. TD3's changes
+//! to DDPG are options beside them, off by default ([`DdpgHerConfig::with_td3`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -49,6 +50,21 @@ pub struct DdpgHerConfig {
     /// NeurIPS 2021) regularises towards the data, for fine-tuning a policy that already
     /// works on a new object without its first updates undoing it.
     pub anchor: f64,
+    /// TD3's clipped double-Q learning (Fujimoto, van Hoof and Meger, "Addressing Function
+    /// Approximation Error in Actor-Critic Methods", ICML 2018): a second critic with its own
+    /// target, and regression targets from the smaller of the two target critics, against
+    /// DDPG's overestimation. Not in DDPG (false).
+    pub twin_critics: bool,
+    /// TD3's target policy smoothing: the standard deviation of Gaussian noise added to the
+    /// target actor's action in the targets, as a share of the action range (TD3: 0.2;
+    /// DDPG: 0).
+    pub target_noise: f64,
+    /// The smoothing noise is clipped to ±this (TD3: 0.5).
+    pub target_noise_clip: f64,
+    /// The actor learns on every this many optimisation steps, the critics on all of them
+    /// (TD3's delayed policy updates: 2; DDPG: 1). The targets follow once per cycle, as in
+    /// the HER baselines, for both.
+    pub policy_delay: usize,
 }
 
 impl Default for DdpgHerConfig {
@@ -73,11 +89,28 @@ impl Default for DdpgHerConfig {
             batches_per_cycle: 40,
             test_episodes: 10,
             anchor: 0.0,
+            twin_critics: false,
+            target_noise: 0.0,
+            target_noise_clip: 0.5,
+            policy_delay: 1,
         }
     }
 }
 
 impl DdpgHerConfig {
+    /// This configuration with TD3's three changes to DDPG at Fujimoto et al.'s values (twin
+    /// critics, target policy smoothing 0.2 clipped to 0.5, the actor updated every second
+    /// step); everything else, HER included, as it was.
+    pub fn with_td3(self) -> Self {
+        DdpgHerConfig {
+            twin_critics: true,
+            target_noise: 0.2,
+            target_noise_clip: 0.5,
+            policy_delay: 2,
+            ..self
+        }
+    }
+
     /// Targets are clipped to [-1/(1-γ), 0], the range of a sparse -1/0 return.
     pub fn clip_return(&self) -> f64 {
         1.0 / (1.0 - self.gamma)

@@ -1,7 +1,8 @@
 //! Learning curves across seeds: the test success of runs that differ only in their seed,
 //! as a mean with a band of one standard deviation, the form of the paper's training-curve
-//! figures. Runs are grouped by their label (environment, mode, object, move), so one call
-//! can draw the paper's comparison of the six Stage 2 moves, a curve per move.
+//! figures. Runs are grouped by their label (environment, mode, object, move) and algorithm
+//! (DDPG or TD3), so one call can draw the paper's comparison of the six Stage 2 moves, a
+//! curve per move, or DDPG's curve beside TD3's.
 
 use std::path::{Path, PathBuf};
 
@@ -42,13 +43,18 @@ pub fn across_seeds(runs: &[&[EpochMetrics]]) -> Result<Vec<(f64, f64, f64)>, St
         .collect()
 }
 
-/// Groups the runs in `dirs` by label, in the order each label first appears, and averages
+/// Groups the runs in `dirs` by label (and algorithm: DDPG or TD3), in the order each label
+/// first appears, and averages
 /// each group across its seeds. Two runs of one label with the same seed, or with different
 /// hyperparameters, are refused.
 pub fn seed_curves(dirs: &[PathBuf]) -> Result<Vec<SeedCurve>, TrainError> {
     let mut groups: Vec<Vec<(&PathBuf, RunCurve)>> = Vec::new();
     for dir in dirs {
-        let run = RunCurve::read(dir)?;
+        let mut run = RunCurve::read(dir)?;
+        if run.config.twin_critics {
+            // TD3's runs are their own curve beside DDPG's of the same environment.
+            run.label.push_str(" (TD3)");
+        }
         let Some(members) = groups.iter_mut().find(|g| g[0].1.label == run.label) else {
             groups.push(vec![(dir, run)]);
             continue;

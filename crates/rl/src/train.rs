@@ -3,7 +3,7 @@
 //! replay buffer, runs `batches_per_cycle` optimisation steps and updates the targets; each
 //! epoch ends with deterministic test episodes. After every epoch it writes, atomically:
 //!
-//! - `checkpoint/`: all four networks and `state.json` (config, normalisers, progress),
+//! - `checkpoint/`: all four networks (six with TD3's twin critics) and `state.json` (config, normalisers, progress),
 //!   from which `resume` continues. Adam's moments and the replay buffer start empty on
 //!   resume; the networks, normalisers, metrics and episode count carry over, and so does how
 //!   the run began (its warm start and critic-only epochs, which only its first call names).
@@ -221,6 +221,9 @@ pub struct Trained {
 
 const NETWORK_FILES: [&str; 4] = ["actor", "critic", "target_actor", "target_critic"];
 
+/// TD3's second critic and its target, in a checkpoint of a run with twin critics.
+const TWIN_FILES: [&str; 2] = ["critic2", "target_critic2"];
+
 /// The anchor's weights in a checkpoint, for a run fine-tuned with one.
 const ANCHOR_FILE: &str = "anchor.safetensors";
 
@@ -429,7 +432,11 @@ fn save_epoch(
     improved: bool,
 ) -> Result<(), TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
-    for (name, tensors) in NETWORK_FILES.iter().zip(agent.networks()) {
+    let twin = agent
+        .twin_networks()
+        .into_iter()
+        .flat_map(|n| TWIN_FILES.iter().zip(n));
+    for (name, tensors) in NETWORK_FILES.iter().zip(agent.networks()).chain(twin) {
         checkpoint::save_tensors(
             &checkpoint_dir.join(format!("{name}.safetensors")),
             &tensors,
@@ -729,15 +736,35 @@ fn load_checkpoint(
         (networks[0], networks[2]) = (actor.clone(), actor);
         (state.observation_norm, state.goal_norm) = (card.observation_norm, card.goal_norm);
     }
+    // A run with twin critics warm-started from a DDPG run keeps its second critic as made:
+    // a copy of the first would learn the same targets on the same batches and stay a copy.
+    let twin_saved = checkpoint_dir.join(format!("{}.safetensors", TWIN_FILES[0]));
+    let mut twin: Option<[Vec<crate::params::NamedTensor>; 2]> = None;
+    if agent.twin_networks().is_some() && twin_saved.exists() {
+        let mut saved: [Vec<crate::params::NamedTensor>; 2] = Default::default();
+        for (slot, name) in saved.iter_mut().zip(TWIN_FILES) {
+            *slot = checkpoint::load_tensors(&checkpoint_dir.join(format!("{name}.safetensors")))?;
+        }
+        twin = Some(saved);
+    }
     let extra = agent.dims.goal.saturating_sub(state.dims.goal);
     if extra > 0 {
         let mut named: Vec<_> = NETWORK_FILES.into_iter().zip(networks.iter_mut()).collect();
+        named.extend(
+            twin.iter_mut()
+                .flat_map(|t| TWIN_FILES.into_iter().zip(t.iter_mut())),
+        );
         widen_goal(&mut named, &mut state.goal_norm, state.dims, extra)
             .map_err(|message| mismatch(checkpoint_dir, message))?;
     }
     agent
         .load_networks(&networks)
         .map_err(|e| mismatch(checkpoint_dir, e.to_string()))?;
+    if let Some(twin) = &twin {
+        agent
+            .load_twin_networks(twin)
+            .map_err(|e| mismatch(checkpoint_dir, e.to_string()))?;
+    }
     agent.observation_norm = state.observation_norm.clone();
     agent.goal_norm = state.goal_norm.clone();
     Ok(state)

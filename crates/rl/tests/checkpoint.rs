@@ -567,3 +567,47 @@ fn a_weight_average_of_snapshots_holds_their_mean_weights_and_pooled_normalisers
         "{err}"
     );
 }
+
+#[test]
+fn a_td3_run_keeps_its_second_critic_and_a_warm_start_from_ddpg_makes_a_new_one() {
+    let dir = fresh_dir("dexcube-rl-td3");
+    let td3 = config().with_td3();
+    let first = train(PointMassEnv::default, td3.clone(), &options(&dir, 2, false)).unwrap();
+    let load = |name: &str| {
+        by_name(
+            dexcube_rl::checkpoint::load_tensors(
+                &dir.join(format!("checkpoint/{name}.safetensors")),
+            )
+            .unwrap(),
+        )
+    };
+    let [second, target] = first
+        .agent
+        .twin_networks()
+        .expect("TD3 has a second critic");
+    assert_eq!(by_name(second.clone()), load("critic2"));
+    assert_eq!(by_name(target), load("target_critic2"));
+    // A resume with nothing left to train holds what the checkpoint saved.
+    let resumed = train(PointMassEnv::default, td3.clone(), &options(&dir, 2, true)).unwrap();
+    assert_eq!(
+        by_name(resumed.agent.twin_networks().unwrap()[0].clone()),
+        load("critic2")
+    );
+    // Resuming it as DDPG is refused: the configuration differs.
+    let err = train(PointMassEnv::default, config(), &options(&dir, 3, true))
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("cannot resume"), "{err}");
+
+    // From a DDPG run the first critic carries over and the second starts as made, not as a
+    // copy that would learn the same as the first.
+    let (source, _, warm, frozen) = warm_start_from_a_new_run("dexcube-rl-td3-warm");
+    let run = train(PointMassEnv::default, frozen.with_td3(), &warm).unwrap();
+    let critic = by_name(
+        dexcube_rl::checkpoint::load_tensors(&source.join("checkpoint/critic.safetensors"))
+            .unwrap(),
+    );
+    assert_eq!(by_name(run.agent.networks()[1].clone()), critic);
+    let second = by_name(run.agent.twin_networks().unwrap()[0].clone());
+    assert!(dexcube_rl::params::l1_distance(&second, &critic) > 0.0);
+}

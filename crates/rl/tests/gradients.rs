@@ -164,3 +164,47 @@ fn a_dropped_object_is_worth_the_floor_and_other_steps_bootstrap() {
         assert!((y[i] - r).abs() < 0.5, "row {i}: {} from reward {r}", y[i]);
     }
 }
+
+#[test]
+fn twin_critics_take_the_smaller_target_and_the_actor_learns_every_second_step() {
+    let (mut ddpg, config) = small_agent(5);
+    let mut td3 = Agent::new(ddpg.dims, config.with_td3(), &Device::flex(), 5);
+    let batch = eight_transitions();
+    // DDPG with TD3's actor and first critic: the targets of one critic.
+    ddpg.load_networks(&td3.networks()).unwrap();
+    let (single, twin) = (ddpg.td_targets(&batch), td3.td_targets(&batch));
+    assert!(
+        single.iter().zip(&twin).all(|(s, t)| t <= s),
+        "{twin:?} never above {single:?}"
+    );
+    assert!(
+        single.iter().zip(&twin).any(|(s, t)| t < s),
+        "and below it where the second critic is lower: {twin:?} against {single:?}"
+    );
+    let [actor0, critic0, ..] = td3.networks();
+    let [second0, _] = td3.twin_networks().expect("a second critic");
+    td3.train(&batch, Learners::ActorAndCritic);
+    let [actor1, critic1, ..] = td3.networks();
+    let [second1, _] = td3.twin_networks().unwrap();
+    assert_eq!(
+        params::l1_distance(&actor0, &actor1),
+        0.0,
+        "the actor waits"
+    );
+    assert!(
+        params::l1_distance(&critic0, &critic1) > 0.0,
+        "critic 1 learns"
+    );
+    assert!(
+        params::l1_distance(&second0, &second1) > 0.0,
+        "critic 2 learns"
+    );
+    td3.train(&batch, Learners::ActorAndCritic);
+    assert!(
+        params::l1_distance(&actor1, &td3.networks()[0]) > 0.0,
+        "and learns on the second step"
+    );
+    td3.end_cycle();
+    assert!(td3.targets_track_no_gradients());
+    assert!(ddpg.twin_networks().is_none(), "DDPG has one critic");
+}
