@@ -115,7 +115,10 @@ pub fn plot_seed_curves(curves: &[SeedCurve], out: &Path) -> Result<PathBuf, Tra
     let series: Vec<Series> = curves
         .iter()
         .map(|curve| Series {
-            label: format!("{} ({} seeds)", curve.label, curve.seeds.len()),
+            label: match curve.seeds.len() {
+                1 => format!("{} (1 seed)", curve.label),
+                n => format!("{} ({n} seeds)", curve.label),
+            },
             points: curve.points.iter().map(|&(x, mean, _)| (x, mean)).collect(),
             band: Some(
                 curve
