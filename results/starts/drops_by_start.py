@@ -14,7 +14,7 @@ import json, struct, sys, math
 def load(path):
     f = open(path, 'rb'); n = struct.unpack('<Q', f.read(8))[0]; h = json.loads(f.read(n)); base = 8 + n
     data = open(path, 'rb').read()
-    out = {}
+    out = {'__metadata__': h.get('__metadata__', {})}
     for k, v in h.items():
         if k == '__metadata__': continue
         a, b = v['data_offsets']; cnt = (b - a) // 8
@@ -29,35 +29,38 @@ def qmul(a, b):
 def rot(q, v):
     w,x,y,z=q; p=(0,)+tuple(v); c=(w,-x,-y,-z)
     r=qmul(qmul(q,p),c); return r[1:]
-rows = []
-for path in sys.argv[1:]:
-    s = load(path)
-    for st, g, d in zip(s['state'], s['pose_goal'], s['dropped']):
-        hand = st[1:25]; pos = st[25:28]; quat = st[28:32]
-        lin = st[84:87]; ang = st[87:90]
-        gpos = g[:3]; gq = g[3:]
-        off = [pos[i]-gpos[i] for i in range(3)]
-        # goal face axis: which cube axis the goal puts up; angle between that axis now and world z
-        # goal up axis in cube frame = inverse(gq) applied to z
-        gi = (gq[0], -gq[1], -gq[2], -gq[3])
-        axis_c = rot(gi, (0,0,1))
-        axis_w = rot(quat, axis_c)
-        tilt = math.degrees(math.acos(max(-1,min(1,abs(axis_w[2])))))  # pair mode: either face
-        up_now = rot(quat,(0,0,1))
-        rows.append(dict(dropped=d, dx=off[0]*100, dy=off[1]*100, dz=off[2]*100,
-            dist=math.hypot(off[0],off[1])*100, speed=math.sqrt(sum(x*x for x in lin))*100,
-            spin=math.sqrt(sum(x*x for x in ang)), tilt=tilt, hand=hand))
-def summarise(key, bins):
+def summarise(rows, key, bins):
     print(key)
     for lo, hi in bins:
         sel = [r for r in rows if lo <= r[key] < hi]
         dr = sum(r['dropped'] for r in sel)
         print(f"  [{lo},{hi}) n={len(sel)} drops={int(dr)} rate={dr/max(1,len(sel)):.3f}")
-print('total', len(rows), int(sum(r['dropped'] for r in rows)))
-summarise('tilt', [(0,10),(10,45),(45,80),(80,91)])
-summarise('dist', [(0,0.5),(0.5,1),(1,1.5),(1.5,2),(2,3),(3,100)])
-summarise('dz', [(-100,-1),(-1,-0.3),(-0.3,0.3),(0.3,1),(1,100)])
-summarise('dx', [(-100,-1),(-1,-0.3),(-0.3,0.3),(0.3,1),(1,100)])
-summarise('dy', [(-100,-1),(-1,-0.3),(-0.3,0.3),(0.3,1),(1,100)])
-summarise('speed', [(0,0.5),(0.5,2),(2,5),(5,1000)])
-summarise('spin', [(0,0.1),(0.1,0.5),(0.5,2),(2,1000)])
+def main():
+    rows = []
+    for path in sys.argv[1:]:
+        s = load(path)
+        for st, g, d in zip(s['state'], s['pose_goal'], s['dropped']):
+            hand = st[1:25]; pos = st[25:28]; quat = st[28:32]
+            lin = st[84:87]; ang = st[87:90]
+            gpos = g[:3]; gq = g[3:]
+            off = [pos[i]-gpos[i] for i in range(3)]
+            # goal face axis: which cube axis the goal puts up; angle between that axis now and world z
+            # goal up axis in cube frame = inverse(gq) applied to z
+            gi = (gq[0], -gq[1], -gq[2], -gq[3])
+            axis_c = rot(gi, (0,0,1))
+            axis_w = rot(quat, axis_c)
+            tilt = math.degrees(math.acos(max(-1,min(1,abs(axis_w[2])))))  # pair mode: either face
+            up_now = rot(quat,(0,0,1))
+            rows.append(dict(dropped=d, dx=off[0]*100, dy=off[1]*100, dz=off[2]*100,
+                dist=math.hypot(off[0],off[1])*100, speed=math.sqrt(sum(x*x for x in lin))*100,
+                spin=math.sqrt(sum(x*x for x in ang)), tilt=tilt, hand=hand))
+    print('total', len(rows), int(sum(r['dropped'] for r in rows)))
+    summarise(rows, 'tilt', [(0,10),(10,45),(45,80),(80,91)])
+    summarise(rows, 'dist', [(0,0.5),(0.5,1),(1,1.5),(1.5,2),(2,3),(3,100)])
+    summarise(rows, 'dz', [(-100,-1),(-1,-0.3),(-0.3,0.3),(0.3,1),(1,100)])
+    summarise(rows, 'dx', [(-100,-1),(-1,-0.3),(-0.3,0.3),(0.3,1),(1,100)])
+    summarise(rows, 'dy', [(-100,-1),(-1,-0.3),(-0.3,0.3),(0.3,1),(1,100)])
+    summarise(rows, 'speed', [(0,0.5),(0.5,2),(2,5),(5,1000)])
+    summarise(rows, 'spin', [(0,0.1),(0.1,0.5),(0.5,2),(2,1000)])
+if __name__ == '__main__':
+    main()
