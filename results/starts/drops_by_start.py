@@ -12,8 +12,9 @@ and spin (rad/s).
 """
 import json, struct, sys, math
 def load(path):
-    f = open(path, 'rb'); n = struct.unpack('<Q', f.read(8))[0]; h = json.loads(f.read(n)); base = 8 + n
-    data = open(path, 'rb').read()
+    with open(path, 'rb') as f:
+        data = f.read()
+    n = struct.unpack_from('<Q', data)[0]; h = json.loads(data[8:8 + n]); base = 8 + n
     out = {'__metadata__': h.get('__metadata__', {})}
     for k, v in h.items():
         if k == '__metadata__': continue
@@ -40,7 +41,7 @@ def main():
     for path in sys.argv[1:]:
         s = load(path)
         for st, g, d in zip(s['state'], s['pose_goal'], s['dropped']):
-            hand = st[1:25]; pos = st[25:28]; quat = st[28:32]
+            pos = st[25:28]; quat = st[28:32]
             lin = st[84:87]; ang = st[87:90]
             gpos = g[:3]; gq = g[3:]
             off = [pos[i]-gpos[i] for i in range(3)]
@@ -50,10 +51,9 @@ def main():
             axis_c = rot(gi, (0,0,1))
             axis_w = rot(quat, axis_c)
             tilt = math.degrees(math.acos(max(-1,min(1,abs(axis_w[2])))))  # pair mode: either face
-            up_now = rot(quat,(0,0,1))
             rows.append(dict(dropped=d, dx=off[0]*100, dy=off[1]*100, dz=off[2]*100,
                 dist=math.hypot(off[0],off[1])*100, speed=math.sqrt(sum(x*x for x in lin))*100,
-                spin=math.sqrt(sum(x*x for x in ang)), tilt=tilt, hand=hand))
+                spin=math.sqrt(sum(x*x for x in ang)), tilt=tilt))
     print('total', len(rows), int(sum(r['dropped'] for r in rows)))
     summarise(rows, 'tilt', [(0,10),(10,45),(45,80),(80,91)])
     summarise(rows, 'dist', [(0,0.5),(0.5,1),(1,1.5),(1.5,2),(2,3),(3,100)])
