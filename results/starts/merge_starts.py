@@ -1,0 +1,72 @@
+"""Joins recordings of starts (`dexcube eval --record-starts`, `dexcube eval-stage --record-starts`) into one file.
+
+Usage: python3 results/starts/merge_starts.py OUT.safetensors FIRST.safetensors SECOND.safetensors [...]
+
+Standard library only; the inputs are read by `drops_by_start.load`. `dexcube train --starts` takes one file;
+this one holds the starts of all the inputs, in order, so a run can draw the operator's hand-overs and fresh
+placements alike (each failed start drawn --failed-weight times as often). The inputs must be of the same stage
+and scene, with the same failure marks and the same state and goal sizes; otherwise it says which differ and
+exits with 2. The output's metadata keeps the stage, scene and marks, and its command names this merge and the
+inputs' own commands. It is written to a temporary file and then renamed.
+"""
+import json, os, struct, sys
+from drops_by_start import load
+
+KEPT = ('stage', 'scene', 'failure')
+
+
+def refuse(message):
+    print(message, file=sys.stderr)
+    sys.exit(2)
+
+
+def width(rows, name, path):
+    sizes = {len(row) for row in rows}
+    if len(sizes) != 1:
+        refuse(f"{path}: its '{name}' rows differ in length")
+    return sizes.pop()
+
+
+def main():
+    if len(sys.argv) < 4:
+        sys.exit(__doc__)
+    out, inputs = sys.argv[1], sys.argv[2:]
+    recordings = [load(path) for path in inputs]
+    for path, recording in zip(inputs, recordings):
+        if 'failed' not in recording:
+            refuse(f"{path} marks its starts with the older 'dropped' only: record it again to merge it")
+    first = recordings[0]
+    for path, recording in zip(inputs[1:], recordings[1:]):
+        for key in KEPT:
+            if recording['__metadata__'].get(key) != first['__metadata__'].get(key):
+                refuse(f"{inputs[0]} and {path} differ in {key}: "
+                       f"{first['__metadata__'].get(key)} against {recording['__metadata__'].get(key)}")
+        for name in ('state', 'goal'):
+            if width(recording[name], name, path) != width(first[name], name, inputs[0]):
+                refuse(f"{inputs[0]} and {path} have '{name}' rows of different sizes")
+    joined = {name: [row for recording in recordings for row in recording[name]] for name in ('state', 'goal')}
+    failed = [x for recording in recordings for x in recording['failed']]
+    header, blobs, offset = {}, [], 0
+    for name, rows in (('state', joined['state']), ('goal', joined['goal'])):
+        blob = struct.pack('<%dd' % (len(rows) * len(rows[0])), *(x for row in rows for x in row))
+        header[name] = {'dtype': 'F64', 'shape': [len(rows), len(rows[0])], 'data_offsets': [offset, offset + len(blob)]}
+        blobs.append(blob)
+        offset += len(blob)
+    blob = struct.pack('<%dd' % len(failed), *failed)
+    header['failed'] = {'dtype': 'F64', 'shape': [len(failed)], 'data_offsets': [offset, offset + len(blob)]}
+    blobs.append(blob)
+    metadata = {key: first['__metadata__'][key] for key in KEPT if key in first['__metadata__']}
+    sources = '; '.join(f"{path}: {r['__metadata__'].get('command', '?')}" for path, r in zip(inputs, recordings))
+    metadata['command'] = f"python3 results/starts/merge_starts.py {out} {' '.join(inputs)} (from {sources})"
+    header['__metadata__'] = metadata
+    text = json.dumps(header).encode()
+    text += b' ' * (-len(text) % 8)
+    tmp = out + '.tmp'
+    with open(tmp, 'wb') as f:
+        f.write(struct.pack('<Q', len(text)) + text + b''.join(blobs))
+    os.replace(tmp, out)
+    print(f"{out}: {len(failed)} starts, {sum(1 for x in failed if x)} failed, from {len(inputs)} recordings")
+
+
+if __name__ == '__main__':
+    main()
