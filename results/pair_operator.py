@@ -13,7 +13,7 @@ cubes lost to a drop in each stage.
 import csv, os, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'starts'))
-from pair_failures import sign_test
+from pair_failures import discordant, sign_test
 
 
 def read(path):
@@ -35,8 +35,7 @@ def summary(rows):
 def compare(label, keys, first, second):
     a = [first[k]['solved'] == 'true' for k in keys]
     b = [second[k]['solved'] == 'true' for k in keys]
-    only_a = sum(x and not y for x, y in zip(a, b))
-    only_b = sum(y and not x for x, y in zip(a, b))
+    only_a, only_b = discordant(a, b)
     print(f"{label}: cubes {len(keys)}; solved: first {sum(a)}, second {sum(b)}; "
           f"only first {only_a}, only second {only_b}; sign test p = {sign_test(only_a, only_b):.3g}")
     print(f"  first:  {summary([first[k] for k in keys])}")

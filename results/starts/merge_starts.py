@@ -27,6 +27,20 @@ def width(rows, name, path):
     return sizes.pop()
 
 
+def safetensors_bytes(tensors, metadata):
+    """The file holding `tensors` ((name, shape, flat F64 values) each) and `metadata`."""
+    header, blobs, offset = {}, [], 0
+    for name, shape, values in tensors:
+        blob = struct.pack('<%dd' % len(values), *values)
+        header[name] = {'dtype': 'F64', 'shape': shape, 'data_offsets': [offset, offset + len(blob)]}
+        blobs.append(blob)
+        offset += len(blob)
+    header['__metadata__'] = metadata
+    text = json.dumps(header).encode()
+    text += b' ' * (-len(text) % 8)
+    return struct.pack('<Q', len(text)) + text + b''.join(blobs)
+
+
 def main():
     if len(sys.argv) < 4:
         sys.exit(__doc__)
@@ -36,34 +50,25 @@ def main():
         if 'failed' not in recording:
             refuse(f"{path} marks its starts with the older 'dropped' only: record it again to merge it")
     first = recordings[0]
+    widths = {name: width(first[name], name, inputs[0]) for name in ('state', 'goal')}
     for path, recording in zip(inputs[1:], recordings[1:]):
         for key in KEPT:
             if recording['__metadata__'].get(key) != first['__metadata__'].get(key):
                 refuse(f"{inputs[0]} and {path} differ in {key}: "
                        f"{first['__metadata__'].get(key)} against {recording['__metadata__'].get(key)}")
-        for name in ('state', 'goal'):
-            if width(recording[name], name, path) != width(first[name], name, inputs[0]):
+        for name in widths:
+            if width(recording[name], name, path) != widths[name]:
                 refuse(f"{inputs[0]} and {path} have '{name}' rows of different sizes")
-    joined = {name: [row for recording in recordings for row in recording[name]] for name in ('state', 'goal')}
     failed = [x for recording in recordings for x in recording['failed']]
-    header, blobs, offset = {}, [], 0
-    for name, rows in (('state', joined['state']), ('goal', joined['goal'])):
-        blob = struct.pack('<%dd' % (len(rows) * len(rows[0])), *(x for row in rows for x in row))
-        header[name] = {'dtype': 'F64', 'shape': [len(rows), len(rows[0])], 'data_offsets': [offset, offset + len(blob)]}
-        blobs.append(blob)
-        offset += len(blob)
-    blob = struct.pack('<%dd' % len(failed), *failed)
-    header['failed'] = {'dtype': 'F64', 'shape': [len(failed)], 'data_offsets': [offset, offset + len(blob)]}
-    blobs.append(blob)
+    tensors = [(name, [len(failed), size], [x for r in recordings for row in r[name] for x in row])
+               for name, size in widths.items()]
+    tensors.append(('failed', [len(failed)], failed))
     metadata = {key: first['__metadata__'][key] for key in KEPT if key in first['__metadata__']}
     sources = '; '.join(f"{path}: {r['__metadata__'].get('command', '?')}" for path, r in zip(inputs, recordings))
     metadata['command'] = f"python3 results/starts/merge_starts.py {out} {' '.join(inputs)} (from {sources})"
-    header['__metadata__'] = metadata
-    text = json.dumps(header).encode()
-    text += b' ' * (-len(text) % 8)
     tmp = out + '.tmp'
     with open(tmp, 'wb') as f:
-        f.write(struct.pack('<Q', len(text)) + text + b''.join(blobs))
+        f.write(safetensors_bytes(tensors, metadata))
     os.replace(tmp, out)
     print(f"{out}: {len(failed)} starts, {sum(1 for x in failed if x)} failed, from {len(inputs)} recordings")
 

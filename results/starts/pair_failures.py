@@ -14,6 +14,11 @@ from drops_by_start import load
 def marks(recording):
     return [x != 0 for x in recording.get('failed') or recording['dropped']]
 
+def discordant(first, second):
+    """How many of the paired marks are set in the first only, and how many in the second only."""
+    return (sum(x and not y for x, y in zip(first, second)),
+            sum(y and not x for x, y in zip(first, second)))
+
 def sign_test(fixed, new):
     n = fixed + new
     if n == 0:
@@ -32,8 +37,7 @@ def main():
         print(f"the two recordings mark failures differently ({meaning[0]} against {meaning[1]}): record both with the same stage", file=sys.stderr)
         sys.exit(2)
     a, b = marks(first), marks(second)
-    fixed = sum(x and not y for x, y in zip(a, b))
-    new = sum(y and not x for x, y in zip(a, b))
+    fixed, new = discordant(a, b)
     print(f"episodes {len(a)}; failed: first {sum(a)}, second {sum(b)}; fixed {fixed}, new {new}; "
           f"sign test p = {sign_test(fixed, new):.3g}; meaning {meaning[0]}/{meaning[1]}")
 
