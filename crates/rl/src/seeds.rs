@@ -115,9 +115,13 @@ pub fn plot_seed_curves(curves: &[SeedCurve], out: &Path) -> Result<PathBuf, Tra
     let series: Vec<Series> = curves
         .iter()
         .map(|curve| Series {
-            label: match curve.seeds.len() {
-                1 => format!("{} (1 seed)", curve.label),
-                n => format!("{} ({n} seeds)", curve.label),
+            label: {
+                let n = curve.seeds.len();
+                format!(
+                    "{} ({n} seed{})",
+                    curve.label,
+                    if n == 1 { "" } else { "s" }
+                )
             },
             points: curve.points.iter().map(|&(x, mean, _)| (x, mean)).collect(),
             band: Some(
