@@ -83,6 +83,10 @@ pub struct TrainArgs {
     /// starts from (--init or --init-actor), beside the action penalty (DDPG: 0).
     #[arg(long, default_value_t = 0.0, value_name = "WEIGHT")]
     anchor: f64,
+    /// What dropping the cube is worth in the critic's targets, as a multiple of the floor
+    /// -1/(1-γ) that missing for ever is worth (DDPG: 1). A resume must say it again.
+    #[arg(long, default_value_t = 1.0, value_name = "MULTIPLE")]
+    drop_cost: f64,
     /// Train without Hindsight Experience Replay (plain DDPG), for ablations.
     #[arg(long)]
     no_her: bool,
@@ -289,6 +293,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         random_eps: args.random_eps.unwrap_or(published.random_eps),
         actor_lr: args.actor_lr.unwrap_or(published.actor_lr),
         anchor: args.anchor,
+        drop_cost: args.drop_cost,
         ..published
     };
     if args.td3 {
@@ -302,6 +307,12 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     }
     if !(config.anchor >= 0.0 && config.anchor.is_finite()) {
         bail!("--anchor must be 0 or more, not {}", config.anchor);
+    }
+    if !(config.drop_cost >= 1.0 && config.drop_cost.is_finite()) {
+        bail!(
+            "--drop-cost must be 1 (the floor) or more, not {}",
+            config.drop_cost
+        );
     }
     if config.anchor > 0.0 && args.init.is_none() && args.init_actor.is_none() && !resume {
         bail!("--anchor holds the actor near the one it starts from: pass --init or --init-actor");

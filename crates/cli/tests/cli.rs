@@ -499,6 +499,10 @@ fn train_refuses_settings_it_cannot_run() {
         (&["rot", "--anchor=-1"], "--anchor must be 0 or more"),
         (&["rot", "--anchor", "10"], "pass --init or --init-actor"),
         (
+            &["rot", "--drop-cost", "0.5"],
+            "--drop-cost must be 1 (the floor) or more",
+        ),
+        (
             &["layer", "--move", "U", "--starts", "s"],
             "train them with --move \"U'\"",
         ),

@@ -65,6 +65,12 @@ pub struct DdpgHerConfig {
     /// (TD3's delayed policy updates: 2; DDPG: 1). The targets follow once per cycle, as in
     /// the HER baselines, for both.
     pub policy_delay: usize,
+    /// What a terminal failure (the object dropped) is worth in the critic's targets, as a
+    /// multiple of the absorbing floor -1/(1-γ), the targets' clip widened to match (1: the
+    /// floor, the return of missing for ever). Above 1 a drop costs more than any run of
+    /// misses can, as it does in the operator, where a drop loses the cube and a miss costs
+    /// one more try. Not in DDPG or the baselines, whose tasks have no terminal states (1).
+    pub drop_cost: f64,
 }
 
 impl Default for DdpgHerConfig {
@@ -93,6 +99,7 @@ impl Default for DdpgHerConfig {
             target_noise: 0.0,
             target_noise_clip: 0.5,
             policy_delay: 1,
+            drop_cost: 1.0,
         }
     }
 }

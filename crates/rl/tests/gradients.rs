@@ -140,7 +140,7 @@ fn targets_follow_by_polyak_and_never_stop_the_online_networks_learning() {
 }
 
 #[test]
-fn a_dropped_object_is_worth_the_floor_and_other_steps_bootstrap() {
+fn a_dropped_object_is_worth_its_drop_cost_and_other_steps_bootstrap() {
     let (agent, config) = small_agent(2);
     let n = 6;
     let batch = Batch {
@@ -163,6 +163,16 @@ fn a_dropped_object_is_worth_the_floor_and_other_steps_bootstrap() {
     for (i, &r) in batch.reward.iter().enumerate().skip(2) {
         assert!((y[i] - r).abs() < 0.5, "row {i}: {} from reward {r}", y[i]);
     }
+    // A drop made to cost three floors is worth exactly that; the other targets are unmoved.
+    let costly = DdpgHerConfig {
+        drop_cost: 3.0,
+        ..config
+    };
+    let mut dearer = Agent::new(agent.dims, costly, &Device::flex(), 2);
+    dearer.load_networks(&agent.networks()).unwrap();
+    let y3 = dearer.td_targets(&batch);
+    assert_eq!(&y3[..2], &[3.0 * floor, 3.0 * floor]);
+    assert_eq!(&y3[2..], &y[2..]);
 }
 
 #[test]
