@@ -3,9 +3,10 @@
 //! averaging once per cycle, and inputs normalised by running statistics.
 //!
 //! One optimisation step on a batch (o, g, u, r, o'):
-//! - target   y = clip(r + γ·Q'(o', g, π'(o', g)), -1/(1-γ), 0), no gradient; where o' ended
+//! - target   y = clip(r + γ·Q'(o', g, π'(o', g)), -c/(1-γ), 0), no gradient; where o' ended
 //!   its episode in an absorbing failure (the object dropped), it fails forever after and
-//!   y = -1/(1-γ), whatever the goal. Bootstrapping from a state that no stored transition
+//!   y = -c/(1-γ), whatever the goal, with c the drop's cost (`DdpgHerConfig::drop_cost`, 1
+//!   in DDPG: the floor, missing for ever). Bootstrapping from a state that no stored transition
 //!   starts from would make a drop look as good as the critic's guess about it;
 //! - critic   minimise mean (Q(o, g, u) - y)²;
 //! - actor    minimise -mean Q(o, g, π(o, g)) + action_l2 · mean π(o, g)²,
