@@ -249,10 +249,10 @@ impl Agent {
             Tensor::from_data(TensorData::new(values.to_vec(), [n, 1]), &self.plain)
         };
         let (reward, terminal) = (column(&batch.reward), column(&batch.terminal));
-        let drop = self.config.clip_return() * self.config.drop_cost;
+        let lowest = self.config.lowest_target();
         let bootstrapped = reward + next_q * self.config.gamma;
-        let failed = terminal.clone() * -drop;
-        (bootstrapped * (terminal.neg() + 1.0) + failed).clamp(-drop, 0.0)
+        let failed = terminal.clone() * lowest;
+        (bootstrapped * (terminal.neg() + 1.0) + failed).clamp(lowest, 0.0)
     }
 
     /// The critic's targets for `batch` as numbers (without smoothing noise), for tests and

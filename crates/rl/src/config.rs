@@ -66,10 +66,11 @@ pub struct DdpgHerConfig {
     /// the HER baselines, for both.
     pub policy_delay: usize,
     /// What a terminal failure (the object dropped) is worth in the critic's targets, as a
-    /// multiple of the absorbing floor -1/(1-γ), the targets' clip widened to match (1: the
-    /// floor, the return of missing for ever). Above 1 a drop costs more than any run of
-    /// misses can, as it does in the operator, where a drop loses the cube and a miss costs
-    /// one more try. Not in DDPG or the baselines, whose tasks have no terminal states (1).
+    /// multiple of the absorbing floor -1/(1-γ), the targets' clip widened to match
+    /// ([`DdpgHerConfig::lowest_target`]; 1: the floor, the return of missing for ever).
+    /// Above 1 a drop costs more than any run of misses can, as it does in the operator,
+    /// where a drop loses the cube and a miss costs one more try. Not in DDPG or the
+    /// baselines, whose tasks have no terminal states (1).
     pub drop_cost: f64,
 }
 
@@ -118,9 +119,15 @@ impl DdpgHerConfig {
         }
     }
 
-    /// Targets are clipped to [-1/(1-γ), 0], the range of a sparse -1/0 return.
+    /// 1/(1-γ): the floor, what missing for ever is worth below 0 (baselines' `clip_return`).
     pub fn clip_return(&self) -> f64 {
         1.0 / (1.0 - self.gamma)
+    }
+
+    /// The lowest target, -drop_cost/(1-γ): what a drop is worth, and where the targets are
+    /// clipped below (the range of a sparse -1/0 return, widened by the drop's cost).
+    pub fn lowest_target(&self) -> f64 {
+        -self.drop_cost * self.clip_return()
     }
 
     /// Probability that a sampled transition gets a relabelled goal.
