@@ -12,7 +12,13 @@ inputs' own commands. It is written to a temporary file and then renamed.
 import json, os, struct, sys
 from drops_by_start import load
 
-KEPT = ('stage', 'scene', 'failure')
+def marks(metadata):
+    """The stage, scene and failure mark of a recording, read as `dexcube` reads them: a file with no
+    stage is Stage 1's, and one with no failure mark (session 19's) marks drops for Stage 1 and the
+    square test for Stage 2."""
+    stage = metadata.get('stage', 'rot')
+    failure = metadata.get('failure', 'dropped' if stage == 'rot' else 'not-square')
+    return {'stage': stage, 'scene': metadata.get('scene'), 'failure': failure}
 
 
 def refuse(message):
@@ -51,11 +57,11 @@ def main():
             refuse(f"{path} marks its starts with the older 'dropped' only: record it again to merge it")
     first = recordings[0]
     widths = {name: width(first[name], name, inputs[0]) for name in ('state', 'goal')}
+    first_marks = marks(first['__metadata__'])
     for path, recording in zip(inputs[1:], recordings[1:]):
-        for key in KEPT:
-            if recording['__metadata__'].get(key) != first['__metadata__'].get(key):
-                refuse(f"{inputs[0]} and {path} differ in {key}: "
-                       f"{first['__metadata__'].get(key)} against {recording['__metadata__'].get(key)}")
+        for key, value in marks(recording['__metadata__']).items():
+            if value != first_marks[key]:
+                refuse(f"{inputs[0]} and {path} differ in {key}: {first_marks[key]} against {value}")
         for name in widths:
             if width(recording[name], name, path) != widths[name]:
                 refuse(f"{inputs[0]} and {path} have '{name}' rows of different sizes")
@@ -63,7 +69,7 @@ def main():
     tensors = [(name, [len(failed), size], [x for r in recordings for row in r[name] for x in row])
                for name, size in widths.items()]
     tensors.append(('failed', [len(failed)], failed))
-    metadata = {key: first['__metadata__'][key] for key in KEPT if key in first['__metadata__']}
+    metadata = {key: value for key, value in first_marks.items() if value is not None}
     sources = '; '.join(f"{path}: {r['__metadata__'].get('command', '?')}" for path, r in zip(inputs, recordings))
     metadata['command'] = f"python3 results/starts/merge_starts.py {out} {' '.join(inputs)} (from {sources})"
     tmp = out + '.tmp'
