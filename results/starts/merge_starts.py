@@ -6,11 +6,13 @@ Standard library only; the inputs are read by `drops_by_start.load`. `dexcube tr
 this one holds the starts of all the inputs, in order, so a run can draw the operator's hand-overs and fresh
 placements alike (each failed start drawn --failed-weight times as often). The inputs must be of the same stage
 and scene, with the same failure marks and the same state and goal sizes; otherwise it says which differ and
-exits with 2. The output's metadata keeps the stage, scene and marks, and its command names this merge and the
+exits with 2 (a recording without a stage or failure mark is read as `dexcube` reads it, see `marks`).
+The output's metadata keeps the stage, scene and marks, and its command names this merge and the
 inputs' own commands. It is written to a temporary file and then renamed.
 """
 import json, os, struct, sys
 from drops_by_start import load
+
 
 def marks(metadata):
     """The stage, scene and failure mark of a recording, read as `dexcube` reads them: a file with no
