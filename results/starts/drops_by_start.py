@@ -24,6 +24,14 @@ def load(path):
         if len(shape) == 2: vals = [vals[i*shape[1]:(i+1)*shape[1]] for i in range(shape[0])]
         out[k] = vals
     return out
+def origin(recording):
+    """The stage, scene and failure mark of a loaded recording, read as `dexcube` reads them
+    (`load_starts`): a file with no stage is Stage 1's, and one with no failure mark (session
+    19's and earlier) marks drops for Stage 1 and the square test for Stage 2."""
+    metadata = recording['__metadata__']
+    stage = metadata.get('stage', 'rot')
+    failure = metadata.get('failure', 'dropped' if stage == 'rot' else 'not-square')
+    return {'stage': stage, 'scene': metadata.get('scene'), 'failure': failure}
 def qmul(a, b):
     w1,x1,y1,z1=a; w2,x2,y2,z2=b
     return (w1*w2-x1*x2-y1*y2-z1*z2, w1*x2+x1*w2+y1*z2-z1*y2, w1*y2-x1*z2+y1*w2+z1*x2, w1*z2+x1*y2-y1*x2+z1*w2)

@@ -6,21 +6,13 @@ Standard library only; the inputs are read by `drops_by_start.load`. `dexcube tr
 this one holds the starts of all the inputs, in order, so a run can draw the operator's hand-overs and fresh
 placements alike (each failed start drawn --failed-weight times as often). The inputs must be of the same stage
 and scene, with the same failure marks and the same state and goal sizes; otherwise it says which differ and
-exits with 2 (a recording without a stage or failure mark is read as `dexcube` reads it, see `marks`).
+exits with 2 (a recording without a stage or failure mark is read as `dexcube` reads it,
+`drops_by_start.origin`).
 The output's metadata keeps the stage, scene and marks, and its command names this merge and the
 inputs' own commands. It is written to a temporary file and then renamed.
 """
 import json, os, struct, sys
-from drops_by_start import load
-
-
-def marks(metadata):
-    """The stage, scene and failure mark of a recording, read as `dexcube` reads them: a file with no
-    stage is Stage 1's, and one with no failure mark (session 19's) marks drops for Stage 1 and the
-    square test for Stage 2."""
-    stage = metadata.get('stage', 'rot')
-    failure = metadata.get('failure', 'dropped' if stage == 'rot' else 'not-square')
-    return {'stage': stage, 'scene': metadata.get('scene'), 'failure': failure}
+from drops_by_start import load, origin
 
 
 def refuse(message):
@@ -59,9 +51,9 @@ def main():
             refuse(f"{path} marks its starts with the older 'dropped' only: record it again to merge it")
     first = recordings[0]
     widths = {name: width(first[name], name, inputs[0]) for name in ('state', 'goal')}
-    first_marks = marks(first['__metadata__'])
+    first_marks = origin(first)
     for path, recording in zip(inputs[1:], recordings[1:]):
-        for key, value in marks(recording['__metadata__']).items():
+        for key, value in origin(recording).items():
             if value != first_marks[key]:
                 refuse(f"{inputs[0]} and {path} differ in {key}: {first_marks[key]} against {value}")
         for name in widths:

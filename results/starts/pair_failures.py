@@ -9,7 +9,7 @@ failed anew, and the two-sided sign test on those discordant episodes. Files fro
 marks `dropped`, later ones `failed`.
 """
 import math, sys
-from drops_by_start import load
+from drops_by_start import load, origin
 
 def marks(recording):
     return [x != 0 for x in recording.get('failed') or recording['dropped']]
@@ -32,7 +32,7 @@ def main():
     if first['state'] != second['state']:
         print("the two recordings do not hold the same episodes (their start states differ): record both with the same stage, --seed and --episodes", file=sys.stderr)
         sys.exit(2)
-    meaning = first['__metadata__'].get('failure'), second['__metadata__'].get('failure')
+    meaning = origin(first)['failure'], origin(second)['failure']
     if meaning[0] != meaning[1]:
         print(f"the two recordings mark failures differently ({meaning[0]} against {meaning[1]}): record both with the same stage", file=sys.stderr)
         sys.exit(2)
