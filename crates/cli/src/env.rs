@@ -85,6 +85,11 @@ pub struct EnvChoice {
     /// The paper's tests read only the pose (CubeRotEnv) or the turned layer (LayerOpEnv).
     #[arg(long)]
     pub square: bool,
+    /// LayerOpEnv on the physical cube only: the observation gains the cube's misalignment
+    /// (the largest angle of a cubelet off a quarter turn, in tenths of a radian), which the
+    /// good state's test reads and the 62 observations do not show.
+    #[arg(long)]
+    pub see_misalignment: bool,
 }
 
 impl EnvChoice {
@@ -106,9 +111,24 @@ impl EnvChoice {
             EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene, self.rot_goal()?)),
             EnvKind::Layer => Box::new(
                 LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
-                    .with_goal(self.layer_goal()?),
+                    .with_goal(self.layer_goal()?)
+                    .with_misalignment_seen(self.sees_misalignment()?),
             ),
         })
+    }
+
+    /// Whether LayerOpEnv shows the policy the cube's misalignment (`--see-misalignment`,
+    /// which only LayerOpEnv on the physical cube can be asked for).
+    pub fn sees_misalignment(&self) -> anyhow::Result<bool> {
+        if self.see_misalignment
+            && (self.env != EnvKind::Layer || self.object()? != ObjectKind::Cube)
+        {
+            bail!(
+                "--see-misalignment is for LayerOpEnv on the physical cube: use train layer \
+                 --object cube"
+            );
+        }
+        Ok(self.see_misalignment)
     }
 
     /// Whether the success test needs the cube left square (`--square`, which only the
@@ -151,9 +171,14 @@ impl EnvChoice {
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
         let square = if self.square()? { ", left square" } else { "" };
+        let seen = if self.sees_misalignment()? {
+            ", misalignment seen"
+        } else {
+            ""
+        };
         Ok(match self.named_object()? {
-            None => format!("{what}{square})"),
-            Some(object) => format!("{what}, {}{square})", object.name()),
+            None => format!("{what}{square}{seen})"),
+            Some(object) => format!("{what}, {}{square}{seen})", object.name()),
         })
     }
 

@@ -845,7 +845,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                         LayerMove::UPrime,
                         LayerGoals::Evaluation,
                     )
-                    .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?);
+                    .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?)
+                    .with_misalignment_seen(PolicyStage2::trained_view(&policy, &prefix)?);
                     Box::new(env.with_starts(numbered(&starts)))
                 }
             };

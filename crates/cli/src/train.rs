@@ -240,6 +240,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     }
     let object = args.choice.object()?;
     let square = args.choice.square()?;
+    let sees_misalignment = args.choice.sees_misalignment()?;
     if args.starts.is_some()
         && matches!(args.choice.env, EnvKind::Layer)
         && args.choice.layer_move != LayerMove::UPrime
@@ -272,7 +273,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 + if args.quarter_goals { "-quarter" } else { "" }
                 + &suffix
         }
-    } + if square { "-square" } else { "" };
+    } + if square { "-square" } else { "" }
+        + if sees_misalignment { "-seen" } else { "" };
     let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
@@ -350,6 +352,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 },
                 if square { ", cube left square" } else { "" }
             ),
+            "observation": if sees_misalignment { "with the cube's misalignment" } else { "paper" },
             "object": object.name(),
             "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
             "critic_only_epochs": args.critic_only_epochs,
@@ -392,6 +395,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             let make = || {
                 LayerOpEnv::with_scene(scene.clone(), layer_move, goals)
                     .with_goal(goal)
+                    .with_misalignment_seen(sees_misalignment)
                     .with_starts(starts.clone())
             };
             train(make, config, &options)?

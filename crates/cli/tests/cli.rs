@@ -488,6 +488,14 @@ fn train_refuses_settings_it_cannot_run() {
         ),
         (&["rot", "--square"], "--square is for the physical cube"),
         (
+            &["layer", "--object", "block", "--see-misalignment"],
+            "--see-misalignment is for LayerOpEnv on the physical cube",
+        ),
+        (
+            &["rot", "--object", "cube", "--see-misalignment"],
+            "--see-misalignment is for LayerOpEnv on the physical cube",
+        ),
+        (
             &["layer", "--random-eps", "1.5"],
             "--random-eps must be between 0 and 1",
         ),
@@ -537,6 +545,93 @@ fn train_refuses_settings_it_cannot_run() {
         );
         assert_clean_failure(&o, 2, says);
     }
+}
+
+/// A Stage 2 policy warm-started onto the view that shows the cube's misalignment gains
+/// that input (63 observations, the shipped 62 kept), and `eval-stage` and the operator give
+/// it that view, told by its size.
+#[test]
+fn a_layer_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
+    let dir = std::env::temp_dir().join("dexcube-cli-see-misalignment");
+    let _ = std::fs::remove_dir_all(&dir);
+    let layer = models().join("layer");
+    let (layer, out) = (layer.to_str().unwrap(), dir.to_str().unwrap());
+    let o = dexcube(
+        &[
+            "train",
+            "layer",
+            "--object",
+            "cube",
+            "--square",
+            "--quarter-goals",
+            "--see-misalignment",
+            "--init-actor",
+            layer,
+            "--critic-only-epochs",
+            "1",
+            "--epochs",
+            "1",
+            "--envs",
+            "1",
+            "--threads",
+            "1",
+            "--batches",
+            "1",
+            "--snapshot-every",
+            "0",
+            "--out",
+            out,
+        ],
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap()).unwrap();
+    assert_eq!(card["dims"]["observation"], 63);
+    assert_eq!(
+        card["metadata"]["environment"]["observation"],
+        "with the cube's misalignment"
+    );
+    let policy = dir.join("policy");
+    let policy = policy.to_str().unwrap();
+    let [rot_flag, rot, _, _] = shipped_policy_flags();
+    let o = dexcube(
+        &[
+            "eval-stage",
+            "layer",
+            "--episodes",
+            "2",
+            "--threads",
+            "1",
+            "--layer-policy",
+            policy,
+            &rot_flag,
+            &rot,
+        ],
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("Stage 2"), "{}", stdout(&o));
+    let o = dexcube(
+        &[
+            "eval",
+            "--per-distance",
+            "1",
+            "--distances",
+            "1",
+            "--rollback-only",
+            "--threads",
+            "1",
+            "--out",
+            dir.join("table").to_str().unwrap(),
+            &rot_flag,
+            &rot,
+            "--layer-policy",
+            policy,
+        ],
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 /// A run resumes only with the recorded starts it began with, and drawn as they were, so

@@ -7,6 +7,10 @@
 //!
 //! Observation (62): hand joint angles 24 and velocities 24, the object's position 3,
 //! orientation 4, velocity 3 and angular velocity 3 (in its own frame), then the layer angle.
+//! On the cube the policy may also be shown the cube's misalignment (63;
+//! [`LayerOpEnv::with_misalignment_seen`]), in units of the good state's tolerance: the part
+//! of the achieved goal that the square test reads and the 62 do not show, so that a side
+//! layer giving way under the fingers is seen as it happens.
 //! On the block the orientation is its bottom layer's; on the cube it is the orientation of
 //! the layer that stays (the one behind the turning face), taken among the cube's 24
 //! symmetric frames as the one nearest the move's base orientation: a 2x2x2 looks the same
@@ -33,7 +37,7 @@ use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
 
 use dexcube_cube::Face;
-use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
+use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::scene::{JointAddress, ObjectJoints};
 use dexcube_sim::{Scene, Sim, SimError};
@@ -121,6 +125,7 @@ pub struct CubeLayer {
     face: Face,
     last: f64,
     turned: f64,
+    sees_misalignment: bool,
 }
 
 impl CubeLayer {
@@ -135,7 +140,29 @@ impl CubeLayer {
             face,
             last: state.layer_angle(face),
             turned: 0.0,
+            sees_misalignment: false,
         })
+    }
+
+    /// The same view, showing the cube's misalignment after the layer angle if `sees`.
+    pub fn seeing_misalignment(mut self, sees: bool) -> CubeLayer {
+        self.sees_misalignment = sees;
+        self
+    }
+
+    /// Whether a Stage 2 policy whose observation has `size` inputs was shown the cube's
+    /// misalignment (63) or not (62); `None` for any other size.
+    pub fn sees_misalignment_at(size: usize) -> Option<bool> {
+        match size.checked_sub(BASE_OBSERVATION + 1)? {
+            0 => Some(false),
+            1 => Some(true),
+            _ => None,
+        }
+    }
+
+    /// How many inputs this view gives the policy.
+    pub fn observation_size(&self) -> usize {
+        BASE_OBSERVATION + 1 + usize::from(self.sees_misalignment)
     }
 
     /// The same count, as if the layer had already turned by `turned` (a recorded start
@@ -145,7 +172,8 @@ impl CubeLayer {
         self
     }
 
-    /// The 62 observations (the layer angle turned so far last).
+    /// The observations: the 62 (the layer angle turned so far last), then the misalignment if
+    /// this view shows it.
     pub fn observe(&mut self, sim: &Sim) -> Vec<f64> {
         self.observe_reading(sim, &read_cube(sim))
     }
@@ -177,7 +205,7 @@ impl CubeLayer {
         );
         let seen = canonical(rotation::normalise(&rotation::mul(&frame, &symmetry)));
         let (velocity, _) = sim.object_velocity();
-        let mut out = Vec::with_capacity(BASE_OBSERVATION + 1);
+        let mut out = Vec::with_capacity(self.observation_size());
         out.extend(sim.hand_angles());
         out.extend(sim.hand_velocities());
         out.extend(state.pose().position);
@@ -185,6 +213,9 @@ impl CubeLayer {
         out.extend(velocity);
         out.extend(rotation::rotate(&rotation::conj(&seen), spin));
         out.push(self.turned);
+        if self.sees_misalignment {
+            out.push(state.misalignment() / ALIGNED_TOLERANCE);
+        }
         out
     }
 
@@ -320,7 +351,8 @@ impl LayerOpEnv {
         if let Layer::Cube(tracker) = &mut self.layer {
             *tracker = CubeLayer::start(&self.hand.sim, facing, base)
                 .expect("a cube scene")
-                .counted_from(turned);
+                .counted_from(turned)
+                .seeing_misalignment(tracker.sees_misalignment);
         }
         let size = match self.goals {
             LayerGoals::Training => self.hand.rng.random_range(0.0..=FRAC_PI_2),
@@ -332,6 +364,16 @@ impl LayerOpEnv {
         (observation, info)
     }
 
+    /// The same environment showing the policy the cube's misalignment if `sees` (see the
+    /// module's doc). Panics if `sees` on the block, whose layers cannot be misaligned.
+    pub fn with_misalignment_seen(mut self, sees: bool) -> LayerOpEnv {
+        match &mut self.layer {
+            Layer::Cube(tracker) => tracker.sees_misalignment = sees,
+            Layer::Block { .. } => assert!(!sees, "the block's layers cannot be misaligned"),
+        }
+        self
+    }
+
     /// The same environment judged by `goal`, e.g. [`LayerGoal::square`] to also need the
     /// cube left in its good state.
     pub fn with_goal(mut self, goal: LayerGoal) -> LayerOpEnv {
@@ -341,8 +383,9 @@ impl LayerOpEnv {
 }
 
 impl Layer {
-    /// The 62 observations and the goals: the layer angle achieved, and with a goal that
-    /// needs the good state, the cube's misalignment (none on the block).
+    /// The observations (62, or 63 with the misalignment seen) and the goals: the layer
+    /// angle achieved, and with a goal that needs the good state, the cube's misalignment
+    /// (none on the block).
     fn observe(&mut self, hand: &HandObject, goal: &LayerGoal, desired: f64) -> Observation {
         let (observation, misalignment) = match self {
             Layer::Block { hinge } => {
@@ -403,7 +446,10 @@ impl SimulatedEnv for LayerOpEnv {
 impl GoalEnv for LayerOpEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
-            observation: BASE_OBSERVATION + 1,
+            observation: match &self.layer {
+                Layer::Block { .. } => BASE_OBSERVATION + 1,
+                Layer::Cube(tracker) => tracker.observation_size(),
+            },
             goal: self.goal.size(),
             action: dexcube_sim::HAND_ACTUATORS,
         }

@@ -335,6 +335,54 @@ fn a_layer_turn_left_square_needs_the_cube_in_its_good_state() {
     assert!(env.goal().is_success(&[a[0], 0.05], &a));
 }
 
+/// With the misalignment seen, Stage 2's observation gains one last number: the achieved
+/// goal's misalignment in units of the good state's tolerance, near 0 on a square cube and
+/// past 1 once a side layer is out of line. The other 62 are those of the paper's view, and
+/// the block refuses to show what it cannot have.
+#[test]
+fn a_layer_op_env_that_sees_the_misalignment_observes_the_achieved_one() {
+    let make = |sees| {
+        LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
+            .unwrap()
+            .with_goal(LayerGoal::square())
+            .with_misalignment_seen(sees)
+    };
+    let (mut plain, mut seeing) = (make(false), make(true));
+    assert_eq!(
+        (plain.spaces().observation, seeing.spaces().observation),
+        (62, 63)
+    );
+    assert_eq!(CubeLayer::sees_misalignment_at(62), Some(false));
+    assert_eq!(CubeLayer::sees_misalignment_at(63), Some(true));
+    assert_eq!(CubeLayer::sees_misalignment_at(61), None);
+    let (without, _) = plain.reset(Some(5));
+    let (with, _) = seeing.reset(Some(5));
+    assert_eq!(with.observation.len(), 63);
+    assert_eq!(with.observation[..62], without.observation[..]);
+    let seen = |o: &dexcube_env::Observation| o.observation[62] * ALIGNED_TOLERANCE;
+    assert!(
+        (seen(&with) - with.achieved_goal[1]).abs() < 1e-12 && seen(&with) < ALIGNED_TOLERANCE,
+        "square at the start: {with:?}"
+    );
+    let achieved = skew_a_side_layer(&mut seeing);
+    let t = seeing.step(&[0.0; 20]);
+    assert!(
+        (seen(&t.observation) - t.observation.achieved_goal[1]).abs() < 1e-12,
+        "the last observation is the achieved misalignment: {:?}",
+        t.observation
+    );
+    assert!(
+        achieved[1] > ALIGNED_TOLERANCE && t.observation.observation[62] > 1.0,
+        "skewed: {achieved:?}"
+    );
+    let block = std::panic::catch_unwind(|| {
+        LayerOpEnv::new(ObjectKind::Block, LayerMove::UPrime, LayerGoals::Evaluation)
+            .unwrap()
+            .with_misalignment_seen(true)
+    });
+    assert!(block.is_err(), "the block has no misalignment to show");
+}
+
 /// Pushes the layer facing +x (a side layer for either stage's goal) 0.35 rad out of line
 /// and steps: checks that the goal reads the misalignment (its last part), that the step is
 /// no success, and that the same achieved goal relabelled as desired (HER) is none either.

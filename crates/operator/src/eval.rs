@@ -66,6 +66,7 @@ impl PolicyFiles {
             },
             stage2: PolicyStage2 {
                 goal: PolicyStage2::trained_goal(&layer, &self.layer)?,
+                sees_misalignment: PolicyStage2::trained_view(&layer, &self.layer)?,
                 policy: layer,
                 resting_z: resting[2],
                 driving: Driving::default(),

@@ -321,6 +321,9 @@ pub struct PolicyStage2 {
     /// The success test the policy was trained on, whose desired goal it is given: the
     /// paper's, or one that also needs the cube left square.
     pub goal: LayerGoal,
+    /// Whether the policy was trained seeing the cube's misalignment as well
+    /// ([`CubeLayer::seeing_misalignment`]).
+    pub sees_misalignment: bool,
     pub resting_z: f64,
     pub driving: Driving,
 }
@@ -339,6 +342,19 @@ impl PolicyStage2 {
             )
         })
     }
+
+    /// Whether a Stage 2 policy (loaded from `path`) sees the cube's misalignment, told by
+    /// the size of its observation input: 62, the paper's view; 63, the misalignment too.
+    pub fn trained_view(policy: &Policy, path: &Path) -> Result<bool, CheckpointError> {
+        let size = policy.card.dims.observation;
+        CubeLayer::sees_misalignment_at(size).ok_or_else(|| CheckpointError::Mismatch {
+            path: path.to_path_buf(),
+            message: format!(
+                "a Stage 2 policy observes 62 numbers (63 with the cube's misalignment), this \
+                 one {size}: pass a policy trained for Stage 2 (LayerOpEnv)"
+            ),
+        })
+    }
 }
 
 /// The cube-frame face whose outward normal points most nearly up in the world.
@@ -350,9 +366,10 @@ const UP: [f64; 3] = [0.0, 0.0, 1.0];
 
 impl Stage2 for PolicyStage2 {
     fn run(&mut self, sim: &mut Sim, watch: Watch) -> StageRun {
-        let Some(mut view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
+        let Some(view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
             return StageRun::default();
         };
+        let mut view = view.seeing_misalignment(self.sees_misalignment);
         let goal = self.goal.desired(FRAC_PI_2);
         let policy = &self.policy;
         drive(

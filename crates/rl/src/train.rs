@@ -603,8 +603,9 @@ fn resume(
 }
 
 /// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had
-/// a shorter goal, as when a success test gains a part (LayerOpEnv's good state): the new goal
-/// inputs then start with zero weights, see [`widen_goal`].
+/// a shorter goal, as when a success test gains a part (LayerOpEnv's good state), or a shorter
+/// observation, as when the policy is shown more (LayerOpEnv's view of the misalignment): the
+/// new inputs then start with zero weights, see [`widen_inputs`].
 fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Result<(), TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
@@ -628,8 +629,8 @@ fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Resul
 }
 
 /// Takes the actor (and its target) and the normalisers of the policy at `prefix` for a new
-/// run whose critic starts afresh. The policy may have had a shorter goal, as for
-/// [`warm_start`].
+/// run whose critic starts afresh. The policy may have had a shorter goal or observation, as
+/// for [`warm_start`].
 fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> {
     let (mut actor, card) = read_policy(prefix)?;
     let (saved, needed) = (card.dims, agent.dims);
@@ -639,22 +640,20 @@ fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> 
             prefix.display()
         )));
     }
-    let mut goal_norm = card.goal_norm;
-    if needed.goal > saved.goal {
-        widen_goal(
-            &mut [("actor", &mut actor)],
-            &mut goal_norm,
-            saved,
-            needed.goal - saved.goal,
-        )
-        .map_err(|message| mismatch(prefix, message))?;
-    }
+    let (mut observation_norm, mut goal_norm) = (card.observation_norm, card.goal_norm);
+    widen_inputs(
+        &mut [("actor", &mut actor)],
+        (&mut observation_norm, &mut goal_norm),
+        saved,
+        needed,
+    )
+    .map_err(|message| mismatch(prefix, message))?;
     let mut networks = agent.networks();
     (networks[0], networks[2]) = (actor.clone(), actor);
     agent
         .load_networks(&networks)
         .map_err(|e| mismatch(prefix, e.to_string()))?;
-    agent.observation_norm = card.observation_norm;
+    agent.observation_norm = observation_norm;
     agent.goal_norm = goal_norm;
     Ok(())
 }
@@ -676,32 +675,44 @@ fn mismatch(path: &Path, message: String) -> TrainError {
     })
 }
 
-/// Whether networks for `saved` sizes can start a run that needs `needed`: the same
-/// observation and action, and a goal no longer (new goal parts are appended).
+/// Whether networks for `saved` sizes can start a run that needs `needed`: the same action,
+/// and an observation and a goal no longer (new parts are appended to each).
 fn can_start_from(saved: Dims, needed: Dims) -> bool {
-    saved.observation == needed.observation
+    saved.observation <= needed.observation
         && saved.action == needed.action
         && saved.goal <= needed.goal
 }
 
-/// Gives networks saved for goals of `saved` components the `extra` goal components appended
-/// after them: zero weights in each first layer, so every network computes what it did, and
-/// goal statistics that keep the old components and feed the new ones as they are.
-fn widen_goal(
+/// Gives networks saved for `saved` sizes the inputs that `needed` appends to the observation
+/// and to the goal: zero weights in each first layer, so every network computes what it did,
+/// and statistics that keep the old inputs and feed the new ones as they are. The first layer
+/// reads the observation, then the goal (then, in a critic, the action).
+fn widen_inputs(
     networks: &mut [(&str, &mut Vec<crate::params::NamedTensor>)],
-    goal_norm: &mut crate::normalizer::Normalizer,
-    dims: Dims,
-    extra: usize,
+    (observation_norm, goal_norm): (
+        &mut crate::normalizer::Normalizer,
+        &mut crate::normalizer::Normalizer,
+    ),
+    saved: Dims,
+    needed: Dims,
 ) -> Result<(), String> {
-    let at = dims.observation + dims.goal;
-    for (name, tensors) in networks.iter_mut() {
-        if !crate::params::insert_zero_inputs(tensors, "layers.0.weight", at, extra) {
-            return Err(format!(
-                "the {name} network has no first layer with {at} inputs or more"
-            ));
+    // The goal's new inputs first, so that the observation's, inserted before them, leave
+    // their place where it was computed.
+    let insertions = [
+        (saved.observation + saved.goal, needed.goal - saved.goal),
+        (saved.observation, needed.observation - saved.observation),
+    ];
+    for (at, extra) in insertions.into_iter().filter(|&(_, extra)| extra > 0) {
+        for (name, tensors) in networks.iter_mut() {
+            if !crate::params::insert_zero_inputs(tensors, "layers.0.weight", at, extra) {
+                return Err(format!(
+                    "the {name} network has no first layer with {at} inputs or more"
+                ));
+            }
         }
     }
-    *goal_norm = goal_norm.widened(extra);
+    *observation_norm = observation_norm.widened(needed.observation - saved.observation);
+    *goal_norm = goal_norm.widened(needed.goal - saved.goal);
     Ok(())
 }
 
@@ -747,15 +758,19 @@ fn load_checkpoint(
         }
         twin = Some(saved);
     }
-    let extra = agent.dims.goal.saturating_sub(state.dims.goal);
-    if extra > 0 {
+    if state.dims != agent.dims {
         let mut named: Vec<_> = NETWORK_FILES.into_iter().zip(networks.iter_mut()).collect();
         named.extend(
             twin.iter_mut()
                 .flat_map(|t| TWIN_FILES.into_iter().zip(t.iter_mut())),
         );
-        widen_goal(&mut named, &mut state.goal_norm, state.dims, extra)
-            .map_err(|message| mismatch(checkpoint_dir, message))?;
+        widen_inputs(
+            &mut named,
+            (&mut state.observation_norm, &mut state.goal_norm),
+            state.dims,
+            agent.dims,
+        )
+        .map_err(|message| mismatch(checkpoint_dir, message))?;
     }
     agent
         .load_networks(&networks)

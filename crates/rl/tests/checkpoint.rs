@@ -352,10 +352,19 @@ fn a_policy_alone_warm_starts_the_actor_and_an_anchor_holds_it_near() {
     assert!(err.to_string().contains("needs a warm start"), "{err}");
 }
 
-/// The point mass with a third goal component appended (0 desired, the distance from the
-/// origin achieved) that its success test also reads, as LayerOpEnv's good state joins the
-/// layer angle.
-struct PointMassWithRadius(PointMassEnv);
+/// The point mass with its distance from the origin appended, as a third goal component (0
+/// desired) that its success test also reads, as LayerOpEnv's good state joins the layer
+/// angle; or as a third observation, as LayerOpEnv may show the cube's misalignment.
+struct PointMassWithRadius {
+    env: PointMassEnv,
+    radius_in: RadiusIn,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum RadiusIn {
+    Goal,
+    Observation,
+}
 
 struct InsideRadius;
 
@@ -372,46 +381,63 @@ impl Goal for InsideRadius {
 }
 
 impl PointMassWithRadius {
-    fn widen(mut observation: Observation) -> Observation {
+    fn widen(&self, mut observation: Observation) -> Observation {
         let radius = observation.achieved_goal[0].hypot(observation.achieved_goal[1]);
-        observation.achieved_goal.push(radius);
-        observation.desired_goal.push(0.0);
+        match self.radius_in {
+            RadiusIn::Goal => {
+                observation.achieved_goal.push(radius);
+                observation.desired_goal.push(0.0);
+            }
+            RadiusIn::Observation => observation.observation.push(radius),
+        }
         observation
     }
 }
 
 impl GoalEnv for PointMassWithRadius {
     fn spaces(&self) -> Spaces {
-        Spaces {
-            goal: 3,
-            ..self.0.spaces()
+        let spaces = self.env.spaces();
+        match self.radius_in {
+            RadiusIn::Goal => Spaces { goal: 3, ..spaces },
+            RadiusIn::Observation => Spaces {
+                observation: 3,
+                ..spaces
+            },
         }
     }
     fn goal(&self) -> Arc<dyn Goal> {
-        Arc::new(InsideRadius)
+        match self.radius_in {
+            RadiusIn::Goal => Arc::new(InsideRadius),
+            RadiusIn::Observation => Arc::new(PointGoal),
+        }
     }
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
-        let (observation, info) = self.0.reset(seed);
-        (Self::widen(observation), info)
+        let (observation, info) = self.env.reset(seed);
+        (self.widen(observation), info)
     }
     fn step(&mut self, action: &[f64]) -> Transition {
-        let t = self.0.step(action);
+        let t = self.env.step(action);
         Transition {
-            observation: Self::widen(t.observation),
+            observation: self.widen(t.observation),
             ..t
         }
     }
 }
 
-/// A success test that gains a goal component warm-starts from the old run: the new input
-/// comes in with zero weights in each network's first layer, so the networks compute what
-/// they did, and the goal normaliser gains the component.
-#[test]
-fn a_warm_start_onto_a_longer_goal_gives_the_new_input_zero_weights() {
-    let (source, _, warm, frozen) = warm_start_from_a_new_run("dexcube-rl-widen");
-    let make = || PointMassWithRadius(PointMassEnv::default());
+/// Warm-starts a run on the point mass with its radius in `radius_in` from a run without it,
+/// and checks that each network's first layer gained one input at `at` with zero weights, so
+/// the networks compute what they did. Returns the new run.
+fn warm_start_onto_a_wider_input(
+    name: &str,
+    radius_in: RadiusIn,
+    at: usize,
+) -> dexcube_rl::train::Trained {
+    let (source, _, warm, frozen) = warm_start_from_a_new_run(name);
+    let make = || PointMassWithRadius {
+        env: PointMassEnv::default(),
+        radius_in,
+    };
     let run = train(make, frozen, &warm).unwrap();
-    let at = 2 + 2; // observation, then the old goal
     for (k, name) in ["actor", "critic", "target_actor", "target_critic"]
         .into_iter()
         .enumerate()
@@ -458,10 +484,34 @@ fn a_warm_start_onto_a_longer_goal_gives_the_new_input_zero_weights() {
             }
         }
     }
+    run
+}
+
+/// A success test that gains a goal component warm-starts from the old run: the new input
+/// comes in after the observation and the old goal, and the goal normaliser gains the
+/// component.
+#[test]
+fn a_warm_start_onto_a_longer_goal_gives_the_new_input_zero_weights() {
+    let run = warm_start_onto_a_wider_input("dexcube-rl-widen", RadiusIn::Goal, 2 + 2);
     assert_eq!(run.agent.goal_norm.size(), 3);
+    assert_eq!(run.agent.observation_norm.size(), 2);
     assert!(
         run.agent.goal_norm.mean(2) > 0.0,
         "the new component learnt from fresh rows"
+    );
+}
+
+/// An observation that gains a number warm-starts from the old run: the new input comes in
+/// after the old observation, before the goal, and the observation normaliser gains it.
+#[test]
+fn a_warm_start_onto_a_longer_observation_gives_the_new_input_zero_weights() {
+    let run =
+        warm_start_onto_a_wider_input("dexcube-rl-widen-observation", RadiusIn::Observation, 2);
+    assert_eq!(run.agent.observation_norm.size(), 3);
+    assert_eq!(run.agent.goal_norm.size(), 2);
+    assert!(
+        run.agent.observation_norm.mean(2) > 0.0,
+        "the new observation learnt from fresh rows"
     );
 }
 
