@@ -840,13 +840,21 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     Box::new(env.with_starts(numbered(&starts)))
                 }
                 EnvKind::Layer => {
+                    let sees_misalignment = PolicyStage2::trained_view(&policy, &prefix)?;
+                    if sees_misalignment && object != ObjectKind::Cube {
+                        bail!(
+                            "{} was trained seeing the cube's misalignment, which only the \
+                             physical cube has: run it with --object cube",
+                            prefix.display()
+                        );
+                    }
                     let env = LayerOpEnv::with_scene(
                         scene.clone(),
                         LayerMove::UPrime,
                         LayerGoals::Evaluation,
                     )
                     .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?)
-                    .with_misalignment_seen(PolicyStage2::trained_view(&policy, &prefix)?);
+                    .with_misalignment_seen(sees_misalignment);
                     Box::new(env.with_starts(numbered(&starts)))
                 }
             };

@@ -549,7 +549,8 @@ fn train_refuses_settings_it_cannot_run() {
 
 /// A Stage 2 policy warm-started onto the view that shows the cube's misalignment gains
 /// that input (63 observations, the shipped 62 kept), and `eval-stage` and the operator give
-/// it that view, told by its size.
+/// it that view, told by its size; `eval-stage` on the block, which has no misalignment to
+/// show, refuses it cleanly.
 #[test]
 fn a_layer_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
     let dir = std::env::temp_dir().join("dexcube-cli-see-misalignment");
@@ -595,23 +596,16 @@ fn a_layer_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
     let policy = dir.join("policy");
     let policy = policy.to_str().unwrap();
     let [rot_flag, rot, _, _] = shipped_policy_flags();
-    let o = dexcube(
-        &[
-            "eval-stage",
-            "layer",
-            "--episodes",
-            "2",
-            "--threads",
-            "1",
-            "--layer-policy",
-            policy,
-            &rot_flag,
-            &rot,
-        ],
-        "",
-    );
+    let eval_stage_on = |object: &str| {
+        let policies = ["--layer-policy", policy, &rot_flag, &rot];
+        let args = ["eval-stage", "layer", "--object", object, "--episodes", "2"];
+        dexcube(&[&args[..], &["--threads", "1"], &policies].concat(), "")
+    };
+    let o = eval_stage_on("cube");
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("Stage 2"), "{}", stdout(&o));
+    let o = eval_stage_on("block");
+    assert_clean_failure(&o, 2, "trained seeing the cube's misalignment");
     let o = dexcube(
         &[
             "eval",
