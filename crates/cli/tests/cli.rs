@@ -135,6 +135,23 @@ fn shipped_policy_flags() -> [String; 4] {
     ]
 }
 
+/// `eval` of one cube at move `distance`, with rollback only, on one thread, into `out`; the
+/// policies and any other flags follow.
+fn eval_one_cube<'a>(distance: &'a str, out: &'a str) -> [&'a str; 10] {
+    [
+        "eval",
+        "--per-distance",
+        "1",
+        "--distances",
+        distance,
+        "--rollback-only",
+        "--threads",
+        "1",
+        "--out",
+        out,
+    ]
+}
+
 #[test]
 fn demo_narrates_the_hand_solving_with_the_shipped_policies() {
     let (rot, layer) = (models().join("rot"), models().join("layer"));
@@ -183,23 +200,17 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
     let (rot, layer) = (models().join("rot"), models().join("layer"));
     let args = [
-        "eval",
-        "--per-distance",
-        "1",
-        "--distances",
-        "1",
-        "--rollback-only",
-        "--seed",
-        "5",
-        "--threads",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-        "--rot-policy",
-        rot.to_str().unwrap(),
-        "--layer-policy",
-        layer.to_str().unwrap(),
-    ];
+        &eval_one_cube("1", out.to_str().unwrap())[..],
+        &[
+            "--seed",
+            "5",
+            "--rot-policy",
+            rot.to_str().unwrap(),
+            "--layer-policy",
+            layer.to_str().unwrap(),
+        ],
+    ]
+    .concat();
     let o = dexcube(&args, "");
     assert!(o.status.success(), "{}", stderr(&o));
     let csv = std::fs::read_to_string(out.with_extension("csv")).unwrap();
@@ -318,17 +329,8 @@ fn eval_records_stage_starts_that_eval_stage_runs_from() {
     let policies = flags.each_ref().map(String::as_str);
     let o = dexcube(
         &[
+            &eval_one_cube("4", dir.join("table").to_str().unwrap())[..],
             &[
-                "eval",
-                "--per-distance",
-                "1",
-                "--distances",
-                "4",
-                "--rollback-only",
-                "--threads",
-                "1",
-                "--out",
-                dir.join("table").to_str().unwrap(),
                 "--record-starts",
                 starts.to_str().unwrap(),
                 "--record-layer-starts",
@@ -606,23 +608,10 @@ fn a_layer_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
     assert!(stdout(&o).contains("Stage 2"), "{}", stdout(&o));
     let o = eval_stage_on("block");
     assert_clean_failure(&o, 2, "trained seeing the cube's misalignment");
+    let table = dir.join("table");
+    let policies = [&rot_flag[..], &rot, "--layer-policy", policy];
     let o = dexcube(
-        &[
-            "eval",
-            "--per-distance",
-            "1",
-            "--distances",
-            "1",
-            "--rollback-only",
-            "--threads",
-            "1",
-            "--out",
-            dir.join("table").to_str().unwrap(),
-            &rot_flag,
-            &rot,
-            "--layer-policy",
-            policy,
-        ],
+        &[&eval_one_cube("1", table.to_str().unwrap())[..], &policies].concat(),
         "",
     );
     assert!(o.status.success(), "{}", stderr(&o));

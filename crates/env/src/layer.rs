@@ -175,7 +175,7 @@ impl CubeLayer {
     /// The observations: the 62 (the layer angle turned so far last), then the misalignment if
     /// this view shows it.
     pub fn observe(&mut self, sim: &Sim) -> Vec<f64> {
-        self.observe_reading(sim, &read_cube(sim))
+        self.observe_reading(sim, &read_cube(sim), None)
     }
 
     /// Follows the layer angle to `sim`'s state without building an observation, for a
@@ -195,8 +195,15 @@ impl CubeLayer {
         self.last = now;
     }
 
-    /// The same from `state`, a reading of the cube in `sim` already taken.
-    fn observe_reading(&mut self, sim: &Sim, state: &CubeState) -> Vec<f64> {
+    /// The same from `state`, a reading of the cube in `sim` already taken, and its
+    /// `misalignment` if that is already worked out (it is read from `state` only if this
+    /// view shows it).
+    fn observe_reading(
+        &mut self,
+        sim: &Sim,
+        state: &CubeState,
+        misalignment: Option<f64>,
+    ) -> Vec<f64> {
         self.follow_reading(state);
         let (frame, spin) = state.layer_behind(self.face);
         let (symmetry, _) = rotation::snap_to_cube(
@@ -214,7 +221,7 @@ impl CubeLayer {
         out.extend(rotation::rotate(&rotation::conj(&seen), spin));
         out.push(self.turned);
         if self.sees_misalignment {
-            out.push(state.misalignment() / ALIGNED_TOLERANCE);
+            out.push(misalignment.unwrap_or_else(|| state.misalignment()) / ALIGNED_TOLERANCE);
         }
         out
     }
@@ -394,13 +401,14 @@ impl Layer {
                 (observation, 0.0)
             }
             Layer::Cube(tracker) => {
-                // One reading of the cube serves the observation and the good state.
+                // One reading of the cube, and of its misalignment, serves the observation
+                // and the good state.
                 let state = read_cube(&hand.sim);
-                let misalignment = match goal.square_threshold {
-                    Some(_) => state.misalignment(),
-                    None => 0.0,
-                };
-                (tracker.observe_reading(&hand.sim, &state), misalignment)
+                let misalignment = goal.square_threshold.map(|_| state.misalignment());
+                (
+                    tracker.observe_reading(&hand.sim, &state, misalignment),
+                    misalignment.unwrap_or(0.0),
+                )
             }
         };
         Observation {
