@@ -85,9 +85,10 @@ pub struct EnvChoice {
     /// The paper's tests read only the pose (CubeRotEnv) or the turned layer (LayerOpEnv).
     #[arg(long)]
     pub square: bool,
-    /// LayerOpEnv on the physical cube only: the observation gains the cube's misalignment
-    /// (the largest angle of a cubelet off a quarter turn, in tenths of a radian), which the
-    /// good state's test reads and the 62 observations do not show.
+    /// On the physical cube only: the observation gains the cube's misalignment (the largest
+    /// angle of a cubelet off a quarter turn, in tenths of a radian), which the good state's
+    /// test reads and the paper's observations (61 for CubeRotEnv, 62 for LayerOpEnv) do not
+    /// show.
     #[arg(long)]
     pub see_misalignment: bool,
 }
@@ -108,7 +109,10 @@ impl EnvChoice {
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
         let scene = Scene::load(self.object()?.scene())?;
         Ok(match self.env {
-            EnvKind::Rot => Box::new(CubeRotEnv::with_scene(scene, self.rot_goal()?)),
+            EnvKind::Rot => Box::new(
+                CubeRotEnv::with_scene(scene, self.rot_goal()?)
+                    .with_misalignment_seen(self.sees_misalignment()?),
+            ),
             EnvKind::Layer => Box::new(
                 LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
                     .with_goal(self.layer_goal()?)
@@ -117,16 +121,11 @@ impl EnvChoice {
         })
     }
 
-    /// Whether LayerOpEnv shows the policy the cube's misalignment (`--see-misalignment`,
-    /// which only LayerOpEnv on the physical cube can be asked for).
+    /// Whether the environment shows the policy the cube's misalignment
+    /// (`--see-misalignment`, which only the physical cube can be asked for).
     pub fn sees_misalignment(&self) -> anyhow::Result<bool> {
-        if self.see_misalignment
-            && (self.env != EnvKind::Layer || self.object()? != ObjectKind::Cube)
-        {
-            bail!(
-                "--see-misalignment is for LayerOpEnv on the physical cube: use train layer \
-                 --object cube"
-            );
+        if self.see_misalignment && self.object()? != ObjectKind::Cube {
+            bail!("--see-misalignment is for the physical cube: use --object cube");
         }
         Ok(self.see_misalignment)
     }

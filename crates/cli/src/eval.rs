@@ -833,21 +833,25 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         episodes,
         || -> anyhow::Result<(Policy, Box<dyn SimulatedEnv>)> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
+            let sees_misalignment = match args.stage {
+                EnvKind::Rot => PolicyStage1::trained_view(&policy, &prefix)?,
+                EnvKind::Layer => PolicyStage2::trained_view(&policy, &prefix)?,
+            };
+            if sees_misalignment && object != ObjectKind::Cube {
+                bail!(
+                    "{} was trained seeing the cube's misalignment, which only the physical \
+                     cube has: run it with --object cube",
+                    prefix.display()
+                );
+            }
             let env: Box<dyn SimulatedEnv> = match args.stage {
                 EnvKind::Rot => {
                     let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
-                    let env = CubeRotEnv::with_scene(scene.clone(), goal);
+                    let env = CubeRotEnv::with_scene(scene.clone(), goal)
+                        .with_misalignment_seen(sees_misalignment);
                     Box::new(env.with_starts(numbered(&starts)))
                 }
                 EnvKind::Layer => {
-                    let sees_misalignment = PolicyStage2::trained_view(&policy, &prefix)?;
-                    if sees_misalignment && object != ObjectKind::Cube {
-                        bail!(
-                            "{} was trained seeing the cube's misalignment, which only the \
-                             physical cube has: run it with --object cube",
-                            prefix.display()
-                        );
-                    }
                     let env = LayerOpEnv::with_scene(
                         scene.clone(),
                         LayerMove::UPrime,

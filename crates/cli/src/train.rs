@@ -382,7 +382,11 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let trained = match args.choice.env {
         EnvKind::Rot => {
             let goal = args.choice.rot_goal()?;
-            let make = || CubeRotEnv::with_scene(scene.clone(), goal).with_starts(starts.clone());
+            let make = || {
+                CubeRotEnv::with_scene(scene.clone(), goal)
+                    .with_misalignment_seen(sees_misalignment)
+                    .with_starts(starts.clone())
+            };
             train(make, config, &options)?
         }
         EnvKind::Layer => {

@@ -491,11 +491,11 @@ fn train_refuses_settings_it_cannot_run() {
         (&["rot", "--square"], "--square is for the physical cube"),
         (
             &["layer", "--object", "block", "--see-misalignment"],
-            "--see-misalignment is for LayerOpEnv on the physical cube",
+            "--see-misalignment is for the physical cube",
         ),
         (
-            &["rot", "--object", "cube", "--see-misalignment"],
-            "--see-misalignment is for LayerOpEnv on the physical cube",
+            &["rot", "--see-misalignment"],
+            "--see-misalignment is for the physical cube",
         ),
         (
             &["layer", "--random-eps", "1.5"],
@@ -549,72 +549,84 @@ fn train_refuses_settings_it_cannot_run() {
     }
 }
 
-/// A Stage 2 policy warm-started onto the view that shows the cube's misalignment gains
-/// that input (63 observations, the shipped 62 kept), and `eval-stage` and the operator give
-/// it that view, told by its size; `eval-stage` on the block, which has no misalignment to
-/// show, refuses it cleanly.
+/// A policy of either stage warm-started onto the view that shows the cube's misalignment
+/// gains that input (62 observations for Stage 1, 63 for Stage 2, the shipped ones kept), and
+/// `eval-stage` and the operator give it that view, told by its size; `eval-stage` on the
+/// other object (the rigid cube, the block), which has no misalignment to show, refuses it
+/// cleanly.
 #[test]
-fn a_layer_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
-    let dir = std::env::temp_dir().join("dexcube-cli-see-misalignment");
-    let _ = std::fs::remove_dir_all(&dir);
-    let layer = models().join("layer");
-    let (layer, out) = (layer.to_str().unwrap(), dir.to_str().unwrap());
-    let o = dexcube(
-        &[
+fn a_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
+    for (stage, shipped, env_args, observation, other_object) in [
+        ("rot", "rot", &["--mode", "pair"][..], 62, "rigid"),
+        ("layer", "layer", &["--quarter-goals"][..], 63, "block"),
+    ] {
+        let dir = std::env::temp_dir().join(format!("dexcube-cli-see-misalignment-{stage}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        let init = models().join(shipped);
+        let (init, out) = (init.to_str().unwrap(), dir.to_str().unwrap());
+        let train = [
             "train",
-            "layer",
+            stage,
             "--object",
             "cube",
             "--square",
-            "--quarter-goals",
             "--see-misalignment",
-            "--init-actor",
-            layer,
-            "--critic-only-epochs",
-            "1",
-            "--epochs",
-            "1",
-            "--envs",
-            "1",
-            "--threads",
-            "1",
-            "--batches",
-            "1",
-            "--snapshot-every",
-            "0",
-            "--out",
-            out,
-        ],
-        "",
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let card: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap()).unwrap();
-    assert_eq!(card["dims"]["observation"], 63);
-    assert_eq!(
-        card["metadata"]["environment"]["observation"],
-        "with the cube's misalignment"
-    );
-    let policy = dir.join("policy");
-    let policy = policy.to_str().unwrap();
-    let [rot_flag, rot, _, _] = shipped_policy_flags();
-    let eval_stage_on = |object: &str| {
-        let policies = ["--layer-policy", policy, &rot_flag, &rot];
-        let args = ["eval-stage", "layer", "--object", object, "--episodes", "2"];
-        dexcube(&[&args[..], &["--threads", "1"], &policies].concat(), "")
-    };
-    let o = eval_stage_on("cube");
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stdout(&o).contains("Stage 2"), "{}", stdout(&o));
-    let o = eval_stage_on("block");
-    assert_clean_failure(&o, 2, "trained seeing the cube's misalignment");
-    let table = dir.join("table");
-    let policies = [&rot_flag[..], &rot, "--layer-policy", policy];
-    let o = dexcube(
-        &[&eval_one_cube("1", table.to_str().unwrap())[..], &policies].concat(),
-        "",
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+        ];
+        let o = dexcube(
+            &[
+                &train[..],
+                env_args,
+                &[
+                    "--init-actor",
+                    init,
+                    "--critic-only-epochs",
+                    "1",
+                    "--epochs",
+                    "1",
+                ],
+                &["--envs", "1", "--threads", "1", "--batches", "1"],
+                &["--snapshot-every", "0", "--out", out],
+            ]
+            .concat(),
+            "",
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        let card: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap())
+                .unwrap();
+        assert_eq!(card["dims"]["observation"], observation);
+        assert_eq!(
+            card["metadata"]["environment"]["observation"],
+            "with the cube's misalignment"
+        );
+        let policy = dir.join("policy");
+        let policy = policy.to_str().unwrap().to_string();
+        let [rot_flag, rot, layer_flag, layer] = shipped_policy_flags();
+        let (rot, layer) = match stage {
+            "rot" => (policy.clone(), layer),
+            _ => (rot, policy.clone()),
+        };
+        let policies = [&rot_flag[..], &rot, &layer_flag, &layer];
+        let eval_stage_on = |object: &str| {
+            let args = ["eval-stage", stage, "--object", object, "--episodes", "2"];
+            dexcube(&[&args[..], &["--threads", "1"], &policies].concat(), "")
+        };
+        let o = eval_stage_on("cube");
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            stdout(&o).contains(if stage == "rot" { "Stage 1" } else { "Stage 2" }),
+            "{}",
+            stdout(&o)
+        );
+        let o = eval_stage_on(other_object);
+        assert_clean_failure(&o, 2, "trained seeing the cube's misalignment");
+        let table = dir.join("table");
+        let o = dexcube(
+            &[&eval_one_cube("1", table.to_str().unwrap())[..], &policies].concat(),
+            "",
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
 }
 
 /// A run resumes only with the recorded starts it began with, and drawn as they were, so

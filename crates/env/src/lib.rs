@@ -38,7 +38,7 @@ pub use hand_object::{
     is_square, resting_point, set_down,
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
-pub use rot::{CubeRotEnv, achieved_goal, pose_goal};
+pub use rot::{CubeRotEnv, achieved_goal, cube_misalignment, pose_goal, rot_observation};
 pub use starts::{RecordedFailure, RecordedStart, StartMix, StartPick};
 pub use vec_env::VecEnv;
 

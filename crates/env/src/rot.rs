@@ -7,6 +7,9 @@
 //! an eighth part, the cube's misalignment (desired 0), and success also needs the cube left
 //! in its good state, as LayerOpEnv's square test does: the paper's test reads only the pose,
 //! and a pose reached with a layer pushed part-way round must be restored before Stage 2.
+//! On the physical cube the policy may also be shown that misalignment (62;
+//! [`CubeRotEnv::with_misalignment_seen`]), in units of the good state's tolerance, as
+//! LayerOpEnv's view can be: the part of the achieved goal that the 61 do not show.
 //!
 //! What is sampled, exactly: at reset the cube is placed at its resting point on the palm
 //! plus N(0, 5 mm) noise on each coordinate, with an orientation drawn uniformly from SO(3)
@@ -20,13 +23,13 @@
 
 use std::sync::Arc;
 
-use dexcube_sim::cube::CubeState;
+use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, RotGoal, RotMode};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, canonical};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, base_observation, canonical};
 use crate::random::uniform_rotation;
 use crate::starts::{RecordedStart, StartMix};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
@@ -53,6 +56,7 @@ pub struct CubeRotEnv {
     goal: Arc<RotGoal>,
     desired: Vec<f64>,
     starts: Option<StartMix>,
+    sees_misalignment: bool,
 }
 
 impl CubeRotEnv {
@@ -73,6 +77,7 @@ impl CubeRotEnv {
             goal: Arc::new(goal),
             desired,
             starts: None,
+            sees_misalignment: false,
         }
     }
 
@@ -96,7 +101,12 @@ impl CubeRotEnv {
 
     /// The episode's first observation and its info.
     fn first_observation(&self) -> (Observation, Info) {
-        let observation = observe(&self.hand, &self.goal, &self.desired);
+        let observation = observe(
+            &self.hand,
+            &self.goal,
+            &self.desired,
+            self.sees_misalignment,
+        );
         let info = self.hand.info(&observation, self.goal.as_ref(), None);
         (observation, info)
     }
@@ -106,6 +116,27 @@ impl CubeRotEnv {
     pub fn with_goal(mut self, goal: RotGoal) -> CubeRotEnv {
         self.goal = Arc::new(goal);
         self
+    }
+
+    /// The same environment showing the policy the cube's misalignment if `sees` (see the
+    /// module's doc). Panics if `sees` on the rigid cube, which is always square.
+    pub fn with_misalignment_seen(mut self, sees: bool) -> CubeRotEnv {
+        assert!(
+            !sees || self.hand.sim.scene().object().cube_balls().is_some(),
+            "the rigid cube cannot be misaligned"
+        );
+        self.sees_misalignment = sees;
+        self
+    }
+
+    /// Whether a Stage 1 policy whose observation has `size` inputs was shown the cube's
+    /// misalignment (62) or not (61); `None` for any other size.
+    pub fn sees_misalignment_at(size: usize) -> Option<bool> {
+        match size.checked_sub(BASE_OBSERVATION)? {
+            0 => Some(false),
+            1 => Some(true),
+            _ => None,
+        }
     }
 
     /// Sets the goal pose (position, then quaternion) for the episode under way.
@@ -130,23 +161,41 @@ impl CubeRotEnv {
     }
 }
 
-/// The 61 observations, with the cube's pose (observations 48 to 54) as the achieved goal,
-/// and with a goal that needs the good state, the cube's misalignment after it.
-fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64]) -> Observation {
-    let observation = hand.base_observation();
+/// The observations, with the cube's pose (observations 48 to 54) as the achieved goal, and
+/// with a goal that needs the good state, the cube's misalignment after it. The misalignment
+/// is read once, and only if the goal or the view needs it.
+fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64], sees: bool) -> Observation {
+    let misalignment =
+        (goal.square_threshold.is_some() || sees).then(|| cube_misalignment(&hand.sim));
+    let observation = rot_observation(&hand.sim, misalignment.filter(|_| sees));
     Observation {
-        achieved_goal: achieved_goal(goal, &hand.sim, &observation[48..55]),
+        achieved_goal: goal.achieved(&observation[48..55], misalignment.unwrap_or(0.0)),
         desired_goal: goal.desired(desired),
         observation,
     }
 }
 
+/// Stage 1's observations of the object in `sim`: the 61, then `seen_misalignment` (radians)
+/// in units of the good state's tolerance if the policy sees it. The operator feeds a
+/// trained policy the same.
+pub fn rot_observation(sim: &Sim, seen_misalignment: Option<f64>) -> Vec<f64> {
+    let mut observation = base_observation(sim);
+    observation.extend(seen_misalignment.map(|m| m / ALIGNED_TOLERANCE));
+    observation
+}
+
+/// The physical cube's misalignment in `sim` (radians); 0 for the rigid cube, which is
+/// always square.
+pub fn cube_misalignment(sim: &Sim) -> f64 {
+    CubeState::read(sim).map_or(0.0, |cube| cube.misalignment())
+}
+
 /// CubeRotEnv's achieved goal for the cube in `sim` at `pose` (position, then quaternion with
 /// w ≥ 0): with a goal that needs the good state, the cube's misalignment after it, which is
-/// read only then (0 for the rigid cube, which is always square).
+/// read only then.
 pub fn achieved_goal(goal: &RotGoal, sim: &Sim, pose: &[f64]) -> Vec<f64> {
     let misalignment = match goal.square_threshold {
-        Some(_) => CubeState::read(sim).map_or(0.0, |cube| cube.misalignment()),
+        Some(_) => cube_misalignment(sim),
         None => 0.0,
     };
     goal.achieved(pose, misalignment)
@@ -182,7 +231,7 @@ impl SimulatedEnv for CubeRotEnv {
 impl GoalEnv for CubeRotEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
-            observation: BASE_OBSERVATION,
+            observation: BASE_OBSERVATION + usize::from(self.sees_misalignment),
             goal: self.goal.size(),
             action: dexcube_sim::HAND_ACTUATORS,
         }
@@ -208,9 +257,10 @@ impl GoalEnv for CubeRotEnv {
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {
-        let (goal, desired) = (&self.goal, &self.desired);
-        self.hand
-            .step(action, goal.as_ref(), |hand| observe(hand, goal, desired))
+        let (goal, desired, sees) = (&self.goal, &self.desired, self.sees_misalignment);
+        self.hand.step(action, goal.as_ref(), |hand| {
+            observe(hand, goal, desired, sees)
+        })
     }
 }
 

@@ -336,9 +336,9 @@ fn a_layer_turn_left_square_needs_the_cube_in_its_good_state() {
 }
 
 /// With the misalignment seen, Stage 2's observation gains one last number: the achieved
-/// goal's misalignment in units of the good state's tolerance, near 0 on a square cube and
-/// past 1 once a side layer is out of line. The other 62 are those of the paper's view, and
-/// the block refuses to show what it cannot have.
+/// goal's misalignment in units of the good state's tolerance (see
+/// [`assert_the_last_observation_is_the_misalignment`]). The block refuses to show what it
+/// cannot have.
 #[test]
 fn a_layer_op_env_that_sees_the_misalignment_observes_the_achieved_one() {
     let make = |sees| {
@@ -347,40 +347,72 @@ fn a_layer_op_env_that_sees_the_misalignment_observes_the_achieved_one() {
             .with_goal(LayerGoal::square())
             .with_misalignment_seen(sees)
     };
-    let (mut plain, mut seeing) = (make(false), make(true));
-    assert_eq!(
-        (plain.spaces().observation, seeing.spaces().observation),
-        (62, 63)
-    );
     assert_eq!(CubeLayer::sees_misalignment_at(62), Some(false));
     assert_eq!(CubeLayer::sees_misalignment_at(63), Some(true));
     assert_eq!(CubeLayer::sees_misalignment_at(61), None);
-    let (without, _) = plain.reset(Some(5));
-    let (with, _) = seeing.reset(Some(5));
-    assert_eq!(with.observation.len(), 63);
-    assert_eq!(with.observation[..62], without.observation[..]);
-    let seen = |o: &dexcube_env::Observation| o.observation[62] * ALIGNED_TOLERANCE;
-    assert!(
-        (seen(&with) - with.achieved_goal[1]).abs() < 1e-12 && seen(&with) < ALIGNED_TOLERANCE,
-        "square at the start: {with:?}"
-    );
-    let achieved = skew_a_side_layer(&mut seeing);
-    let t = seeing.step(&[0.0; 20]);
-    assert!(
-        (seen(&t.observation) - t.observation.achieved_goal[1]).abs() < 1e-12,
-        "the last observation is the achieved misalignment: {:?}",
-        t.observation
-    );
-    assert!(
-        achieved[1] > ALIGNED_TOLERANCE && t.observation.observation[62] > 1.0,
-        "skewed: {achieved:?}"
-    );
+    assert_the_last_observation_is_the_misalignment(&mut make(false), &mut make(true), 62);
     let block = std::panic::catch_unwind(|| {
         LayerOpEnv::new(ObjectKind::Block, LayerMove::UPrime, LayerGoals::Evaluation)
             .unwrap()
             .with_misalignment_seen(true)
     });
     assert!(block.is_err(), "the block has no misalignment to show");
+}
+
+/// Stage 1 may see the misalignment as Stage 2 does: its 61 observations gain the same last
+/// number. The rigid cube, always square, refuses to show it.
+#[test]
+fn a_cube_rot_env_that_sees_the_misalignment_observes_the_achieved_one() {
+    let scene = Scene::load(ObjectKind::Cube.scene()).unwrap();
+    let make = |sees| {
+        CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Pair).left_square())
+            .with_misalignment_seen(sees)
+    };
+    assert_eq!(CubeRotEnv::sees_misalignment_at(61), Some(false));
+    assert_eq!(CubeRotEnv::sees_misalignment_at(62), Some(true));
+    assert_eq!(CubeRotEnv::sees_misalignment_at(63), None);
+    assert_the_last_observation_is_the_misalignment(&mut make(false), &mut make(true), 61);
+    let rigid = std::panic::catch_unwind(|| {
+        CubeRotEnv::new(RotMode::Paper)
+            .unwrap()
+            .with_misalignment_seen(true)
+    });
+    assert!(rigid.is_err(), "the rigid cube has no misalignment to show");
+}
+
+/// `seeing` observes what `plain` does (`paper` numbers, from the same reset) and then the
+/// achieved goal's misalignment (its last part) in units of the good state's tolerance:
+/// under 1 on the square cube at the start, past 1 once a side layer is out of line.
+fn assert_the_last_observation_is_the_misalignment(
+    plain: &mut dyn SimulatedEnv,
+    seeing: &mut dyn SimulatedEnv,
+    paper: usize,
+) {
+    assert_eq!(
+        (plain.spaces().observation, seeing.spaces().observation),
+        (paper, paper + 1)
+    );
+    let (without, _) = plain.reset(Some(5));
+    let (with, _) = seeing.reset(Some(5));
+    assert_eq!(with.observation.len(), paper + 1);
+    assert_eq!(with.observation[..paper], without.observation[..]);
+    let seen = |o: &dexcube_env::Observation| o.observation[paper] * ALIGNED_TOLERANCE;
+    let achieved = |o: &dexcube_env::Observation| *o.achieved_goal.last().unwrap();
+    assert!(
+        (seen(&with) - achieved(&with)).abs() < 1e-12 && seen(&with) < ALIGNED_TOLERANCE,
+        "square at the start: {with:?}"
+    );
+    let skewed = skew_a_side_layer(seeing);
+    let t = seeing.step(&[0.0; 20]);
+    assert!(
+        (seen(&t.observation) - achieved(&t.observation)).abs() < 1e-12,
+        "the last observation is the achieved misalignment: {:?}",
+        t.observation
+    );
+    assert!(
+        skewed[skewed.len() - 1] > ALIGNED_TOLERANCE && t.observation.observation[paper] > 1.0,
+        "skewed: {skewed:?}"
+    );
 }
 
 /// Pushes the layer facing +x (a side layer for either stage's goal) 0.35 rad out of line

@@ -61,6 +61,7 @@ impl PolicyFiles {
         Ok(LoadedStages {
             stage1: PolicyStage1 {
                 goal: PolicyStage1::trained_goal(&rot, self.rot_mode, &self.rot)?,
+                sees_misalignment: PolicyStage1::trained_view(&rot, &self.rot)?,
                 policy: rot,
                 driving: Driving::default(),
             },

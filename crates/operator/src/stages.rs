@@ -9,8 +9,9 @@ use std::path::Path;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, EPISODE_STEPS, Goal, LayerGoal, RecordedStart, RotGoal, RotMode, SETTLE_STEPS,
-    achieved_goal, base_observation, is_dropped, pose_goal, set_down,
+    CubeLayer, CubeRotEnv, EPISODE_STEPS, Goal, LayerGoal, RecordedStart, RotGoal, RotMode,
+    SETTLE_STEPS, achieved_goal, cube_misalignment, is_dropped, pose_goal, rot_observation,
+    set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -249,6 +250,9 @@ pub struct PolicyStage1 {
     /// its run is held to: the paper's in some mode, or one that also needs the cube left
     /// square.
     pub goal: RotGoal,
+    /// Whether the policy was trained seeing the cube's misalignment as well
+    /// ([`CubeRotEnv::with_misalignment_seen`]).
+    pub sees_misalignment: bool,
     pub driving: Driving,
 }
 
@@ -264,6 +268,18 @@ impl PolicyStage1 {
         RotGoal::of_size(mode, size).ok_or_else(|| {
             wrong_goal_size(path, "1 (CubeRotEnv)", "7 numbers (the pose) or 8", size)
         })
+    }
+
+    /// Whether a Stage 1 policy (loaded from `path`) sees the cube's misalignment, told by
+    /// the size of its observation input: 61, the paper's view; 62, the misalignment too.
+    pub fn trained_view(policy: &Policy, path: &Path) -> Result<bool, CheckpointError> {
+        trained_view(
+            policy,
+            path,
+            "1 (CubeRotEnv)",
+            61,
+            CubeRotEnv::sees_misalignment_at,
+        )
     }
 }
 
@@ -281,7 +297,7 @@ fn wrong_goal_size(path: &Path, stage: &str, expected: &str, size: usize) -> Che
 impl Stage1 for PolicyStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
         let goal = self.goal.desired(&pose_goal(position, target));
-        let policy = &self.policy;
+        let (policy, sees_misalignment) = (&self.policy, self.sees_misalignment);
         let reached = pose_reached(self.goal);
         let mut running = 0;
         let mut held = |sim: &Sim| {
@@ -300,7 +316,8 @@ impl Stage1 for PolicyStage1 {
             .map(|steadying| Steadier::new(steadying, position));
         let act = |sim: &Sim| {
             steadied_action(steadier.as_mut(), sim, || {
-                policy.act(&base_observation(sim), &goal)
+                let seen = sees_misalignment.then(|| cube_misalignment(sim));
+                policy.act(&rot_observation(sim, seen), &goal)
             })
         };
         drive(
@@ -346,15 +363,35 @@ impl PolicyStage2 {
     /// Whether a Stage 2 policy (loaded from `path`) sees the cube's misalignment, told by
     /// the size of its observation input: 62, the paper's view; 63, the misalignment too.
     pub fn trained_view(policy: &Policy, path: &Path) -> Result<bool, CheckpointError> {
-        let size = policy.card.dims.observation;
-        CubeLayer::sees_misalignment_at(size).ok_or_else(|| CheckpointError::Mismatch {
-            path: path.to_path_buf(),
-            message: format!(
-                "a Stage 2 policy observes 62 numbers (63 with the cube's misalignment), this \
-                 one {size}: pass a policy trained for Stage 2 (LayerOpEnv)"
-            ),
-        })
+        trained_view(
+            policy,
+            path,
+            "2 (LayerOpEnv)",
+            62,
+            CubeLayer::sees_misalignment_at,
+        )
     }
+}
+
+/// Whether a policy (loaded from `path`) for `stage` sees the cube's misalignment, as
+/// `sees_at` tells from the size of its observation input: `plain`, the paper's view; one
+/// more, the misalignment too.
+fn trained_view(
+    policy: &Policy,
+    path: &Path,
+    stage: &str,
+    plain: usize,
+    sees_at: fn(usize) -> Option<bool>,
+) -> Result<bool, CheckpointError> {
+    let size = policy.card.dims.observation;
+    sees_at(size).ok_or_else(|| CheckpointError::Mismatch {
+        path: path.to_path_buf(),
+        message: format!(
+            "a Stage {stage} policy observes {plain} numbers ({} with the cube's misalignment), \
+             this one {size}: pass a policy trained for that stage",
+            plain + 1
+        ),
+    })
 }
 
 /// The cube-frame face whose outward normal points most nearly up in the world.
