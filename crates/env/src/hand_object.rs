@@ -18,6 +18,17 @@ use crate::{EPISODE_STEPS, Info, Observation, Transition};
 /// position 3, orientation 4, velocity 3, angular velocity 3.
 pub const BASE_OBSERVATION: usize = 61;
 
+/// Whether a policy whose observation has `size` inputs was shown the cube's misalignment
+/// after its environment's `paper` numbers (one more input) or not (`paper`); `None` for any
+/// other size.
+pub(crate) fn sees_misalignment_after(paper: usize, size: usize) -> Option<bool> {
+    match size.checked_sub(paper)? {
+        0 => Some(false),
+        1 => Some(true),
+        _ => None,
+    }
+}
+
 /// How far below its resting point the object must fall to count as dropped, metres.
 pub const DROP_DEPTH: f64 = 0.05;
 

@@ -44,7 +44,9 @@ use dexcube_sim::{Scene, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, LayerGoal, wrap_angle};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, ObjectKind, canonical};
+use crate::hand_object::{
+    BASE_OBSERVATION, HandObject, ObjectKind, canonical, sees_misalignment_after,
+};
 use crate::starts::{RecordedStart, StartMix};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
@@ -153,11 +155,7 @@ impl CubeLayer {
     /// Whether a Stage 2 policy whose observation has `size` inputs was shown the cube's
     /// misalignment (63) or not (62); `None` for any other size.
     pub fn sees_misalignment_at(size: usize) -> Option<bool> {
-        match size.checked_sub(BASE_OBSERVATION + 1)? {
-            0 => Some(false),
-            1 => Some(true),
-            _ => None,
-        }
+        sees_misalignment_after(BASE_OBSERVATION + 1, size)
     }
 
     /// How many inputs this view gives the policy.

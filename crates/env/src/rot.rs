@@ -29,7 +29,9 @@ use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, RotGoal, RotMode};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, base_observation, canonical};
+use crate::hand_object::{
+    BASE_OBSERVATION, HandObject, base_observation, canonical, sees_misalignment_after,
+};
 use crate::random::uniform_rotation;
 use crate::starts::{RecordedStart, StartMix};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
@@ -132,11 +134,7 @@ impl CubeRotEnv {
     /// Whether a Stage 1 policy whose observation has `size` inputs was shown the cube's
     /// misalignment (62) or not (61); `None` for any other size.
     pub fn sees_misalignment_at(size: usize) -> Option<bool> {
-        match size.checked_sub(BASE_OBSERVATION)? {
-            0 => Some(false),
-            1 => Some(true),
-            _ => None,
-        }
+        sees_misalignment_after(BASE_OBSERVATION, size)
     }
 
     /// Sets the goal pose (position, then quaternion) for the episode under way.
