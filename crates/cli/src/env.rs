@@ -8,7 +8,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
     CubeRotEnv, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RotGoal,
-    RotMode,
+    RotMode, View,
 };
 use dexcube_sim::Scene;
 use rand::{Rng, SeedableRng};
@@ -91,6 +91,12 @@ pub struct EnvChoice {
     /// show.
     #[arg(long)]
     pub see_misalignment: bool,
+    /// On the physical cube only: the observation gains the hand's grip, the normal force in
+    /// newtons with which the thumb, each finger and the palm press on the cube (six numbers,
+    /// after the misalignment if that is seen too), which the paper's observations show
+    /// only through the cube's motion.
+    #[arg(long)]
+    pub see_grip: bool,
 }
 
 impl EnvChoice {
@@ -109,25 +115,32 @@ impl EnvChoice {
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
         let scene = Scene::load(self.object()?.scene())?;
         Ok(match self.env {
-            EnvKind::Rot => Box::new(
-                CubeRotEnv::with_scene(scene, self.rot_goal()?)
-                    .with_misalignment_seen(self.sees_misalignment()?),
-            ),
+            EnvKind::Rot => {
+                Box::new(CubeRotEnv::with_scene(scene, self.rot_goal()?).with_view(self.view()?))
+            }
             EnvKind::Layer => Box::new(
                 LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
                     .with_goal(self.layer_goal()?)
-                    .with_misalignment_seen(self.sees_misalignment()?),
+                    .with_view(self.view()?),
             ),
         })
     }
 
-    /// Whether the environment shows the policy the cube's misalignment
-    /// (`--see-misalignment`, which only the physical cube can be asked for).
-    pub fn sees_misalignment(&self) -> anyhow::Result<bool> {
-        if self.see_misalignment && self.object()? != ObjectKind::Cube {
-            bail!("--see-misalignment is for the physical cube: use --object cube");
+    /// What the environment shows the policy beyond the paper's observations
+    /// (`--see-misalignment`, `--see-grip`, which only the physical cube can be asked for).
+    pub fn view(&self) -> anyhow::Result<View> {
+        for (flag, asked) in [
+            ("--see-misalignment", self.see_misalignment),
+            ("--see-grip", self.see_grip),
+        ] {
+            if asked && self.object()? != ObjectKind::Cube {
+                bail!("{flag} is for the physical cube: use --object cube");
+            }
         }
-        Ok(self.see_misalignment)
+        Ok(View {
+            misalignment: self.see_misalignment,
+            grip: self.see_grip,
+        })
     }
 
     /// Whether the success test needs the cube left square (`--square`, which only the
@@ -170,11 +183,9 @@ impl EnvChoice {
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
         let square = if self.square()? { ", left square" } else { "" };
-        let seen = if self.sees_misalignment()? {
-            ", misalignment seen"
-        } else {
-            ""
-        };
+        let seen = (self.view()?.name())
+            .map(|name| format!(", {name} seen"))
+            .unwrap_or_default();
         Ok(match self.named_object()? {
             None => format!("{what}{square}{seen})"),
             Some(object) => format!("{what}, {}{square}{seen})", object.name()),

@@ -833,22 +833,23 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         episodes,
         || -> anyhow::Result<(Policy, Box<dyn SimulatedEnv>)> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
-            let sees_misalignment = match args.stage {
+            let view = match args.stage {
                 EnvKind::Rot => PolicyStage1::trained_view(&policy, &prefix)?,
                 EnvKind::Layer => PolicyStage2::trained_view(&policy, &prefix)?,
             };
-            if sees_misalignment && object != ObjectKind::Cube {
+            if let Some(seen) = view.name()
+                && object != ObjectKind::Cube
+            {
                 bail!(
-                    "{} was trained seeing the cube's misalignment, which only the physical \
-                     cube has: run it with --object cube",
+                    "{} was trained seeing the {seen}, a view of the physical cube: run it \
+                     with --object cube",
                     prefix.display()
                 );
             }
             let env: Box<dyn SimulatedEnv> = match args.stage {
                 EnvKind::Rot => {
                     let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
-                    let env = CubeRotEnv::with_scene(scene.clone(), goal)
-                        .with_misalignment_seen(sees_misalignment);
+                    let env = CubeRotEnv::with_scene(scene.clone(), goal).with_view(view);
                     Box::new(env.with_starts(numbered(&starts)))
                 }
                 EnvKind::Layer => {
@@ -858,7 +859,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                         LayerGoals::Evaluation,
                     )
                     .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?)
-                    .with_misalignment_seen(sees_misalignment);
+                    .with_view(view);
                     Box::new(env.with_starts(numbered(&starts)))
                 }
             };

@@ -240,7 +240,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     }
     let object = args.choice.object()?;
     let square = args.choice.square()?;
-    let sees_misalignment = args.choice.sees_misalignment()?;
+    let view = args.choice.view()?;
     if args.starts.is_some()
         && matches!(args.choice.env, EnvKind::Layer)
         && args.choice.layer_move != LayerMove::UPrime
@@ -274,7 +274,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 + &suffix
         }
     } + if square { "-square" } else { "" }
-        + if sees_misalignment { "-seen" } else { "" };
+        + if view.misalignment { "-seen" } else { "" }
+        + if view.grip { "-grip" } else { "" };
     let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
@@ -352,7 +353,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 },
                 if square { ", cube left square" } else { "" }
             ),
-            "observation": if sees_misalignment { "with the cube's misalignment" } else { "paper" },
+            "observation": view.name().map_or("paper".to_string(), |name| format!("with the {name}")),
             "object": object.name(),
             "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
             "critic_only_epochs": args.critic_only_epochs,
@@ -384,7 +385,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             let goal = args.choice.rot_goal()?;
             let make = || {
                 CubeRotEnv::with_scene(scene.clone(), goal)
-                    .with_misalignment_seen(sees_misalignment)
+                    .with_view(view)
                     .with_starts(starts.clone())
             };
             train(make, config, &options)?
@@ -399,7 +400,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             let make = || {
                 LayerOpEnv::with_scene(scene.clone(), layer_move, goals)
                     .with_goal(goal)
-                    .with_misalignment_seen(sees_misalignment)
+                    .with_view(view)
                     .with_starts(starts.clone())
             };
             train(make, config, &options)?

@@ -498,6 +498,10 @@ fn train_refuses_settings_it_cannot_run() {
             "--see-misalignment is for the physical cube",
         ),
         (
+            &["rot", "--see-grip"],
+            "--see-grip is for the physical cube",
+        ),
+        (
             &["layer", "--random-eps", "1.5"],
             "--random-eps must be between 0 and 1",
         ),
@@ -549,32 +553,40 @@ fn train_refuses_settings_it_cannot_run() {
     }
 }
 
-/// A policy of either stage warm-started onto the view that shows the cube's misalignment
-/// gains that input (62 observations for Stage 1, 63 for Stage 2, the shipped ones kept), and
-/// `eval-stage` and the operator give it that view, told by its size; `eval-stage` on the
-/// other object (the rigid cube, the block), which has no misalignment to show, refuses it
-/// cleanly.
+/// A policy of either stage warm-started onto a view beyond the paper's gains its inputs
+/// (Stage 2 the cube's misalignment: 63 observations; Stage 1 that and the grip: 68; the
+/// shipped ones kept), and `eval-stage` and the operator give it that view, told by its size;
+/// `eval-stage` on the other object (the rigid cube, the block), which the views are not
+/// for, refuses it cleanly.
 #[test]
-fn a_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
-    for (stage, shipped, env_args, observation, other_object) in [
-        ("rot", "rot", &["--mode", "pair"][..], 62, "rigid"),
-        ("layer", "layer", &["--quarter-goals"][..], 63, "block"),
+fn a_policy_trained_seeing_more_is_evaluated_with_it() {
+    for (stage, view, env_args, observation, seen, other_object) in [
+        (
+            "rot",
+            &["--see-misalignment", "--see-grip"][..],
+            &["--mode", "pair"][..],
+            68,
+            "misalignment and grip",
+            "rigid",
+        ),
+        (
+            "layer",
+            &["--see-misalignment"],
+            &["--quarter-goals"],
+            63,
+            "misalignment",
+            "block",
+        ),
     ] {
-        let dir = std::env::temp_dir().join(format!("dexcube-cli-see-misalignment-{stage}"));
+        let dir = std::env::temp_dir().join(format!("dexcube-cli-see-more-{stage}"));
         let _ = std::fs::remove_dir_all(&dir);
-        let init = models().join(shipped);
+        let init = models().join(stage);
         let (init, out) = (init.to_str().unwrap(), dir.to_str().unwrap());
-        let train = [
-            "train",
-            stage,
-            "--object",
-            "cube",
-            "--square",
-            "--see-misalignment",
-        ];
+        let train = ["train", stage, "--object", "cube", "--square"];
         let o = dexcube(
             &[
                 &train[..],
+                view,
                 env_args,
                 &[
                     "--init-actor",
@@ -597,7 +609,7 @@ fn a_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
         assert_eq!(card["dims"]["observation"], observation);
         assert_eq!(
             card["metadata"]["environment"]["observation"],
-            "with the cube's misalignment"
+            format!("with the {seen}")
         );
         let policy = dir.join("policy");
         let policy = policy.to_str().unwrap().to_string();
@@ -619,7 +631,7 @@ fn a_policy_trained_seeing_the_misalignment_is_evaluated_with_it() {
             stdout(&o)
         );
         let o = eval_stage_on(other_object);
-        assert_clean_failure(&o, 2, "trained seeing the cube's misalignment");
+        assert_clean_failure(&o, 2, &format!("trained seeing the {seen}, a view of"));
         let table = dir.join("table");
         let o = dexcube(
             &[&eval_one_cube("1", table.to_str().unwrap())[..], &policies].concat(),

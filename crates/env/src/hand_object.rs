@@ -1,12 +1,13 @@
 //! What CubeRotEnv and LayerOpEnv share: the hand with an object on its palm, the first 61
-//! observations, placing the object at reset, the drop test, and turning a goal's verdict
+//! observations and what a policy may be shown beyond its stage's ([`View`]), placing the
+//! object at reset, the drop test, and turning a goal's verdict
 //! into a `Transition`.
 
 use std::sync::Arc;
 
-use dexcube_sim::cube::CubeState;
+use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
 use dexcube_sim::rotation::Quat;
-use dexcube_sim::{HAND_ACTUATORS, Pose, Scene, SceneKind, Sim};
+use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, Pose, Scene, SceneKind, Sim};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -18,14 +19,75 @@ use crate::{EPISODE_STEPS, Info, Observation, Transition};
 /// position 3, orientation 4, velocity 3, angular velocity 3.
 pub const BASE_OBSERVATION: usize = 61;
 
-/// Whether a policy whose observation has `size` inputs was shown the cube's misalignment
-/// after its environment's `paper` numbers (one more input) or not (`paper`); `None` for any
-/// other size.
-pub(crate) fn sees_misalignment_after(paper: usize, size: usize) -> Option<bool> {
-    match size.checked_sub(paper)? {
-        0 => Some(false),
-        1 => Some(true),
-        _ => None,
+/// What a policy is shown beyond its stage's paper observations, appended after them in this
+/// order; both parts are for the physical cube. A trained policy's view is told from the size
+/// of its observation ([`View::after`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct View {
+    /// The cube's misalignment in units of the good state's tolerance (one number): the part
+    /// of a square goal's achieved goal that the paper's observations do not show.
+    pub misalignment: bool,
+    /// The hand's grip on the cube ([`Sim::grip`]: the normal force in newtons with which the
+    /// thumb, each finger and the palm press on it; six numbers), which the joint angles
+    /// show only through the cube's motion.
+    pub grip: bool,
+}
+
+impl View {
+    /// The paper's observations alone.
+    pub const PAPER: View = View {
+        misalignment: false,
+        grip: false,
+    };
+
+    const ALL: [View; 4] = [
+        View::PAPER,
+        View {
+            misalignment: true,
+            grip: false,
+        },
+        View {
+            misalignment: false,
+            grip: true,
+        },
+        View {
+            misalignment: true,
+            grip: true,
+        },
+    ];
+
+    /// How many numbers this view appends to the paper's.
+    pub fn size(self) -> usize {
+        usize::from(self.misalignment) + if self.grip { GRIP_PARTS.len() } else { 0 }
+    }
+
+    /// The view of a policy whose observation has `size` inputs after its stage's `paper`
+    /// ones; `None` if no view has that size.
+    pub fn after(paper: usize, size: usize) -> Option<View> {
+        let extra = size.checked_sub(paper)?;
+        View::ALL.into_iter().find(|view| view.size() == extra)
+    }
+
+    /// What the view adds, in words for labels: `None` for the paper's, else "misalignment",
+    /// "grip" or "misalignment and grip".
+    pub fn name(self) -> Option<&'static str> {
+        match (self.misalignment, self.grip) {
+            (false, false) => None,
+            (true, false) => Some("misalignment"),
+            (false, true) => Some("grip"),
+            (true, true) => Some("misalignment and grip"),
+        }
+    }
+
+    /// Appends what this view shows of `sim` to `observation`; `misalignment` gives the
+    /// cube's (radians), asked for only if the view shows it.
+    pub fn extend(self, observation: &mut Vec<f64>, sim: &Sim, misalignment: impl FnOnce() -> f64) {
+        if self.misalignment {
+            observation.push(misalignment() / ALIGNED_TOLERANCE);
+        }
+        if self.grip {
+            observation.extend(sim.grip());
+        }
     }
 }
 
@@ -216,7 +278,7 @@ impl HandObject {
 pub fn base_observation(sim: &Sim) -> Vec<f64> {
     let pose = sim.object_pose();
     let (velocity, angular) = sim.object_velocity();
-    let mut out = Vec::with_capacity(BASE_OBSERVATION + 1);
+    let mut out = Vec::with_capacity(BASE_OBSERVATION + 1 + GRIP_PARTS.len());
     out.extend(sim.hand_angles());
     out.extend(sim.hand_velocities());
     out.extend(pose.position);

@@ -7,10 +7,10 @@
 //!
 //! Observation (62): hand joint angles 24 and velocities 24, the object's position 3,
 //! orientation 4, velocity 3 and angular velocity 3 (in its own frame), then the layer angle.
-//! On the cube the policy may also be shown the cube's misalignment (63;
-//! [`LayerOpEnv::with_misalignment_seen`]), in units of the good state's tolerance: the part
-//! of the achieved goal that the square test reads and the 62 do not show, so that a side
-//! layer giving way under the fingers is seen as it happens.
+//! On the cube the policy may also be shown more ([`LayerOpEnv::with_view`]): the cube's
+//! misalignment (63), in units of the good state's tolerance, the part of the achieved goal
+//! that the square test reads and the 62 do not show, so that a side layer giving way under
+//! the fingers is seen as it happens; and the hand's grip on the cube (six more).
 //! On the block the orientation is its bottom layer's; on the cube it is the orientation of
 //! the layer that stays (the one behind the turning face), taken among the cube's 24
 //! symmetric frames as the one nearest the move's base orientation: a 2x2x2 looks the same
@@ -37,16 +37,14 @@ use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
 
 use dexcube_cube::Face;
-use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, face_toward, turn_face_by};
+use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::scene::{JointAddress, ObjectJoints};
 use dexcube_sim::{Scene, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, LayerGoal, wrap_angle};
-use crate::hand_object::{
-    BASE_OBSERVATION, HandObject, ObjectKind, canonical, sees_misalignment_after,
-};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, ObjectKind, View, canonical};
 use crate::starts::{RecordedStart, StartMix};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
@@ -127,7 +125,7 @@ pub struct CubeLayer {
     face: Face,
     last: f64,
     turned: f64,
-    sees_misalignment: bool,
+    view: View,
 }
 
 impl CubeLayer {
@@ -142,25 +140,25 @@ impl CubeLayer {
             face,
             last: state.layer_angle(face),
             turned: 0.0,
-            sees_misalignment: false,
+            view: View::PAPER,
         })
     }
 
-    /// The same view, showing the cube's misalignment after the layer angle if `sees`.
-    pub fn seeing_misalignment(mut self, sees: bool) -> CubeLayer {
-        self.sees_misalignment = sees;
+    /// The same, showing `view` after the layer angle.
+    pub fn with_view(mut self, view: View) -> CubeLayer {
+        self.view = view;
         self
     }
 
-    /// Whether a Stage 2 policy whose observation has `size` inputs was shown the cube's
-    /// misalignment (63) or not (62); `None` for any other size.
-    pub fn sees_misalignment_at(size: usize) -> Option<bool> {
-        sees_misalignment_after(BASE_OBSERVATION + 1, size)
+    /// The view of a Stage 2 policy whose observation has `size` inputs (62 the paper's, 63
+    /// with the misalignment, 68 with the grip, 69 with both); `None` for any other size.
+    pub fn view_at(size: usize) -> Option<View> {
+        View::after(BASE_OBSERVATION + 1, size)
     }
 
     /// How many inputs this view gives the policy.
     pub fn observation_size(&self) -> usize {
-        BASE_OBSERVATION + 1 + usize::from(self.sees_misalignment)
+        BASE_OBSERVATION + 1 + self.view.size()
     }
 
     /// The same count, as if the layer had already turned by `turned` (a recorded start
@@ -170,8 +168,8 @@ impl CubeLayer {
         self
     }
 
-    /// The observations: the 62 (the layer angle turned so far last), then the misalignment if
-    /// this view shows it.
+    /// The observations: the 62 (the layer angle turned so far last), then what the view
+    /// shows beyond them.
     pub fn observe(&mut self, sim: &Sim) -> Vec<f64> {
         self.observe_reading(sim, &read_cube(sim), None)
     }
@@ -218,9 +216,9 @@ impl CubeLayer {
         out.extend(velocity);
         out.extend(rotation::rotate(&rotation::conj(&seen), spin));
         out.push(self.turned);
-        if self.sees_misalignment {
-            out.push(misalignment.unwrap_or_else(|| state.misalignment()) / ALIGNED_TOLERANCE);
-        }
+        self.view.extend(&mut out, sim, || {
+            misalignment.unwrap_or_else(|| state.misalignment())
+        });
         out
     }
 
@@ -357,7 +355,7 @@ impl LayerOpEnv {
             *tracker = CubeLayer::start(&self.hand.sim, facing, base)
                 .expect("a cube scene")
                 .counted_from(turned)
-                .seeing_misalignment(tracker.sees_misalignment);
+                .with_view(tracker.view);
         }
         let size = match self.goals {
             LayerGoals::Training => self.hand.rng.random_range(0.0..=FRAC_PI_2),
@@ -369,12 +367,16 @@ impl LayerOpEnv {
         (observation, info)
     }
 
-    /// The same environment showing the policy the cube's misalignment if `sees` (see the
-    /// module's doc). Panics if `sees` on the block, whose layers cannot be misaligned.
-    pub fn with_misalignment_seen(mut self, sees: bool) -> LayerOpEnv {
+    /// The same environment showing the policy `view` beyond the paper's 62 (see the
+    /// module's doc). Panics if it shows more than the paper's on the block: the views are
+    /// for the physical cube.
+    pub fn with_view(mut self, view: View) -> LayerOpEnv {
         match &mut self.layer {
-            Layer::Cube(tracker) => tracker.sees_misalignment = sees,
-            Layer::Block { .. } => assert!(!sees, "the block's layers cannot be misaligned"),
+            Layer::Cube(tracker) => tracker.view = view,
+            Layer::Block { .. } => assert!(
+                view == View::PAPER,
+                "the views beyond the paper's are for the physical cube"
+            ),
         }
         self
     }
@@ -388,7 +390,7 @@ impl LayerOpEnv {
 }
 
 impl Layer {
-    /// The observations (62, or 63 with the misalignment seen) and the goals: the layer
+    /// The observations (62, and what the view shows beyond them) and the goals: the layer
     /// angle achieved, and with a goal that needs the good state, the cube's misalignment
     /// (none on the block).
     fn observe(&mut self, hand: &HandObject, goal: &LayerGoal, desired: f64) -> Observation {

@@ -7,9 +7,10 @@
 //! an eighth part, the cube's misalignment (desired 0), and success also needs the cube left
 //! in its good state, as LayerOpEnv's square test does: the paper's test reads only the pose,
 //! and a pose reached with a layer pushed part-way round must be restored before Stage 2.
-//! On the physical cube the policy may also be shown that misalignment (62;
-//! [`CubeRotEnv::with_misalignment_seen`]), in units of the good state's tolerance, as
-//! LayerOpEnv's view can be: the part of the achieved goal that the 61 do not show.
+//! On the physical cube the policy may also be shown more ([`CubeRotEnv::with_view`]): that
+//! misalignment (62), in units of the good state's tolerance, as LayerOpEnv's view can be, the
+//! part of the achieved goal that the 61 do not show; and the hand's grip on the cube (six
+//! more), the force with which the thumb, each finger and the palm press on it.
 //!
 //! What is sampled, exactly: at reset the cube is placed at its resting point on the palm
 //! plus N(0, 5 mm) noise on each coordinate, with an orientation drawn uniformly from SO(3)
@@ -23,15 +24,13 @@
 
 use std::sync::Arc;
 
-use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
+use dexcube_sim::cube::CubeState;
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, RotGoal, RotMode};
-use crate::hand_object::{
-    BASE_OBSERVATION, HandObject, base_observation, canonical, sees_misalignment_after,
-};
+use crate::hand_object::{BASE_OBSERVATION, HandObject, View, base_observation, canonical};
 use crate::random::uniform_rotation;
 use crate::starts::{RecordedStart, StartMix};
 use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
@@ -58,7 +57,7 @@ pub struct CubeRotEnv {
     goal: Arc<RotGoal>,
     desired: Vec<f64>,
     starts: Option<StartMix>,
-    sees_misalignment: bool,
+    view: View,
 }
 
 impl CubeRotEnv {
@@ -79,7 +78,7 @@ impl CubeRotEnv {
             goal: Arc::new(goal),
             desired,
             starts: None,
-            sees_misalignment: false,
+            view: View::PAPER,
         }
     }
 
@@ -103,12 +102,7 @@ impl CubeRotEnv {
 
     /// The episode's first observation and its info.
     fn first_observation(&self) -> (Observation, Info) {
-        let observation = observe(
-            &self.hand,
-            &self.goal,
-            &self.desired,
-            self.sees_misalignment,
-        );
+        let observation = observe(&self.hand, &self.goal, &self.desired, self.view);
         let info = self.hand.info(&observation, self.goal.as_ref(), None);
         (observation, info)
     }
@@ -120,21 +114,22 @@ impl CubeRotEnv {
         self
     }
 
-    /// The same environment showing the policy the cube's misalignment if `sees` (see the
-    /// module's doc). Panics if `sees` on the rigid cube, which is always square.
-    pub fn with_misalignment_seen(mut self, sees: bool) -> CubeRotEnv {
+    /// The same environment showing the policy `view` beyond the paper's 61 (see the
+    /// module's doc). Panics if it shows more than the paper's on the rigid cube: the views
+    /// are for the physical cube.
+    pub fn with_view(mut self, view: View) -> CubeRotEnv {
         assert!(
-            !sees || self.hand.sim.scene().object().cube_balls().is_some(),
-            "the rigid cube cannot be misaligned"
+            view == View::PAPER || self.hand.sim.scene().object().cube_balls().is_some(),
+            "the views beyond the paper's are for the physical cube"
         );
-        self.sees_misalignment = sees;
+        self.view = view;
         self
     }
 
-    /// Whether a Stage 1 policy whose observation has `size` inputs was shown the cube's
-    /// misalignment (62) or not (61); `None` for any other size.
-    pub fn sees_misalignment_at(size: usize) -> Option<bool> {
-        sees_misalignment_after(BASE_OBSERVATION, size)
+    /// The view of a Stage 1 policy whose observation has `size` inputs (61 the paper's, 62
+    /// with the misalignment, 67 with the grip, 68 with both); `None` for any other size.
+    pub fn view_at(size: usize) -> Option<View> {
+        View::after(BASE_OBSERVATION, size)
     }
 
     /// Sets the goal pose (position, then quaternion) for the episode under way.
@@ -162,10 +157,10 @@ impl CubeRotEnv {
 /// The observations, with the cube's pose (observations 48 to 54) as the achieved goal, and
 /// with a goal that needs the good state, the cube's misalignment after it. The misalignment
 /// is read once, and only if the goal or the view needs it.
-fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64], sees: bool) -> Observation {
-    let misalignment =
-        (goal.square_threshold.is_some() || sees).then(|| cube_misalignment(&hand.sim));
-    let observation = rot_observation(&hand.sim, misalignment.filter(|_| sees));
+fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64], view: View) -> Observation {
+    let misalignment = (goal.square_threshold.is_some() || view.misalignment)
+        .then(|| cube_misalignment(&hand.sim));
+    let observation = rot_observation(&hand.sim, view, misalignment);
     Observation {
         achieved_goal: goal.achieved(&observation[48..55], misalignment.unwrap_or(0.0)),
         desired_goal: goal.desired(desired),
@@ -173,12 +168,14 @@ fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64], sees: bool) -> Ob
     }
 }
 
-/// Stage 1's observations of the object in `sim`: the 61, then `seen_misalignment` (radians)
-/// in units of the good state's tolerance if the policy sees it. The operator feeds a
-/// trained policy the same.
-pub fn rot_observation(sim: &Sim, seen_misalignment: Option<f64>) -> Vec<f64> {
+/// Stage 1's observations of the object in `sim`: the 61, then what `view` shows beyond them,
+/// the cube's misalignment taken from `misalignment` (radians) if already read. The operator
+/// feeds a trained policy the same.
+pub fn rot_observation(sim: &Sim, view: View, misalignment: Option<f64>) -> Vec<f64> {
     let mut observation = base_observation(sim);
-    observation.extend(seen_misalignment.map(|m| m / ALIGNED_TOLERANCE));
+    view.extend(&mut observation, sim, || {
+        misalignment.unwrap_or_else(|| cube_misalignment(sim))
+    });
     observation
 }
 
@@ -229,7 +226,7 @@ impl SimulatedEnv for CubeRotEnv {
 impl GoalEnv for CubeRotEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
-            observation: BASE_OBSERVATION + usize::from(self.sees_misalignment),
+            observation: BASE_OBSERVATION + self.view.size(),
             goal: self.goal.size(),
             action: dexcube_sim::HAND_ACTUATORS,
         }
@@ -255,9 +252,9 @@ impl GoalEnv for CubeRotEnv {
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {
-        let (goal, desired, sees) = (&self.goal, &self.desired, self.sees_misalignment);
+        let (goal, desired, view) = (&self.goal, &self.desired, self.view);
         self.hand.step(action, goal.as_ref(), |hand| {
-            observe(hand, goal, desired, sees)
+            observe(hand, goal, desired, view)
         })
     }
 }

@@ -4,7 +4,7 @@ use dexcube_env::layer::LayerGoals;
 use dexcube_env::rot::PAPER_TARGETS;
 use dexcube_env::{
     CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind,
-    RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, VecEnv, pose_goal,
+    RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, VecEnv, View, pose_goal,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
@@ -345,18 +345,38 @@ fn a_layer_op_env_that_sees_the_misalignment_observes_the_achieved_one() {
         LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
             .unwrap()
             .with_goal(LayerGoal::square())
-            .with_misalignment_seen(sees)
+            .with_view(seeing(sees, false))
     };
-    assert_eq!(CubeLayer::sees_misalignment_at(62), Some(false));
-    assert_eq!(CubeLayer::sees_misalignment_at(63), Some(true));
-    assert_eq!(CubeLayer::sees_misalignment_at(61), None);
+    assert_views_told_by_size(CubeLayer::view_at, 62);
     assert_the_last_observation_is_the_misalignment(&mut make(false), &mut make(true), 62);
     let block = std::panic::catch_unwind(|| {
         LayerOpEnv::new(ObjectKind::Block, LayerMove::UPrime, LayerGoals::Evaluation)
             .unwrap()
-            .with_misalignment_seen(true)
+            .with_view(seeing(true, false))
     });
     assert!(block.is_err(), "the block has no misalignment to show");
+}
+
+/// A view of `misalignment` and `grip` or not.
+fn seeing(misalignment: bool, grip: bool) -> View {
+    View { misalignment, grip }
+}
+
+/// `view_at` tells each view from an observation of `paper` numbers and what the view adds
+/// (one for the misalignment, six for the grip), and no view from any other size near them.
+fn assert_views_told_by_size(view_at: fn(usize) -> Option<View>, paper: usize) {
+    let told = (paper - 2..paper + 10)
+        .filter_map(|size| view_at(size).map(|view| (size - paper, view)))
+        .collect::<Vec<_>>();
+    assert_eq!(
+        told,
+        [
+            (0, View::PAPER),
+            (1, seeing(true, false)),
+            (6, seeing(false, true)),
+            (7, seeing(true, true)),
+        ]
+    );
 }
 
 /// Stage 1 may see the misalignment as Stage 2 does: its 61 observations gain the same last
@@ -366,18 +386,68 @@ fn a_cube_rot_env_that_sees_the_misalignment_observes_the_achieved_one() {
     let scene = Scene::load(ObjectKind::Cube.scene()).unwrap();
     let make = |sees| {
         CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Pair).left_square())
-            .with_misalignment_seen(sees)
+            .with_view(seeing(sees, false))
     };
-    assert_eq!(CubeRotEnv::sees_misalignment_at(61), Some(false));
-    assert_eq!(CubeRotEnv::sees_misalignment_at(62), Some(true));
-    assert_eq!(CubeRotEnv::sees_misalignment_at(63), None);
+    assert_views_told_by_size(CubeRotEnv::view_at, 61);
     assert_the_last_observation_is_the_misalignment(&mut make(false), &mut make(true), 61);
     let rigid = std::panic::catch_unwind(|| {
         CubeRotEnv::new(RotMode::Paper)
             .unwrap()
-            .with_misalignment_seen(true)
+            .with_view(seeing(true, false))
     });
     assert!(rigid.is_err(), "the rigid cube has no misalignment to show");
+}
+
+/// Either stage may be shown the hand's grip: six numbers after the paper's (and after the
+/// misalignment, if that is shown too), the forces the physics reads for the thumb, the
+/// fingers and the palm, which rise as the hand closes on the cube.
+#[test]
+fn an_env_that_sees_the_grip_observes_the_forces_on_the_cube() {
+    let scene = Scene::load(ObjectKind::Cube.scene()).unwrap();
+    let rot = |view| {
+        Box::new(
+            CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Pair).left_square())
+                .with_view(view),
+        ) as Box<dyn SimulatedEnv>
+    };
+    let layer = |view| {
+        Box::new(
+            LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
+                .unwrap()
+                .with_view(view),
+        ) as Box<dyn SimulatedEnv>
+    };
+    for (make, paper) in [
+        (&rot as &dyn Fn(View) -> Box<dyn SimulatedEnv>, 61),
+        (&layer, 62),
+    ] {
+        let (mut plain, mut gripping, mut both) = (
+            make(View::PAPER),
+            make(seeing(false, true)),
+            make(seeing(true, true)),
+        );
+        assert_eq!(gripping.spaces().observation, paper + 6);
+        assert_eq!(both.spaces().observation, paper + 7);
+        let (without, _) = plain.reset(Some(5));
+        let (with, _) = gripping.reset(Some(5));
+        let (with_both, _) = both.reset(Some(5));
+        assert_eq!(with.observation[..paper], without.observation[..]);
+        assert_eq!(with.observation[paper..], gripping.sim().grip());
+        assert_eq!(
+            with_both.observation[paper + 1..],
+            with.observation[paper..]
+        );
+        let resting: f64 = with.observation[paper..].iter().sum();
+        assert!(resting > 0.0, "the hand bears the cube: {with:?}");
+        let closing = [1.0; 20];
+        let t = (0..5).map(|_| gripping.step(&closing)).last().unwrap();
+        assert_eq!(t.observation.observation[paper..], gripping.sim().grip());
+        let pressed: f64 = t.observation.observation[paper..].iter().sum();
+        assert!(
+            pressed > 2.0 * resting,
+            "a closing hand presses harder: {resting} then {pressed}"
+        );
+    }
 }
 
 /// `seeing` observes what `plain` does (`paper` numbers, from the same reset) and then the

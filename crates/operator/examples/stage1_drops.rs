@@ -59,7 +59,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
     let goal = PolicyStage1::trained_goal(&policy, RotMode::Pair, &prefix)?;
     let mut env = CubeRotEnv::with_scene(Scene::load(SceneKind::Cube)?, goal)
-        .with_misalignment_seen(PolicyStage1::trained_view(&policy, &prefix)?)
+        .with_view(PolicyStage1::trained_view(&policy, &prefix)?)
         .with_starts(Some(StartMix {
             starts: starts.clone(),
             pick: StartPick::Numbered,

@@ -61,13 +61,13 @@ impl PolicyFiles {
         Ok(LoadedStages {
             stage1: PolicyStage1 {
                 goal: PolicyStage1::trained_goal(&rot, self.rot_mode, &self.rot)?,
-                sees_misalignment: PolicyStage1::trained_view(&rot, &self.rot)?,
+                view: PolicyStage1::trained_view(&rot, &self.rot)?,
                 policy: rot,
                 driving: Driving::default(),
             },
             stage2: PolicyStage2 {
                 goal: PolicyStage2::trained_goal(&layer, &self.layer)?,
-                sees_misalignment: PolicyStage2::trained_view(&layer, &self.layer)?,
+                view: PolicyStage2::trained_view(&layer, &self.layer)?,
                 policy: layer,
                 resting_z: resting[2],
                 driving: Driving::default(),

@@ -10,8 +10,7 @@ use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
     CubeLayer, CubeRotEnv, EPISODE_STEPS, Goal, LayerGoal, RecordedStart, RotGoal, RotMode,
-    SETTLE_STEPS, achieved_goal, cube_misalignment, is_dropped, pose_goal, rot_observation,
-    set_down,
+    SETTLE_STEPS, View, achieved_goal, is_dropped, pose_goal, rot_observation, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -250,9 +249,9 @@ pub struct PolicyStage1 {
     /// its run is held to: the paper's in some mode, or one that also needs the cube left
     /// square.
     pub goal: RotGoal,
-    /// Whether the policy was trained seeing the cube's misalignment as well
-    /// ([`CubeRotEnv::with_misalignment_seen`]).
-    pub sees_misalignment: bool,
+    /// What the policy was trained to see beyond the paper's observations
+    /// ([`CubeRotEnv::with_view`]).
+    pub view: View,
     pub driving: Driving,
 }
 
@@ -270,16 +269,10 @@ impl PolicyStage1 {
         })
     }
 
-    /// Whether a Stage 1 policy (loaded from `path`) sees the cube's misalignment, told by
-    /// the size of its observation input: 61, the paper's view; 62, the misalignment too.
-    pub fn trained_view(policy: &Policy, path: &Path) -> Result<bool, CheckpointError> {
-        trained_view(
-            policy,
-            path,
-            "1 (CubeRotEnv)",
-            61,
-            CubeRotEnv::sees_misalignment_at,
-        )
+    /// What a Stage 1 policy (loaded from `path`) sees, told by the size of its observation
+    /// input ([`CubeRotEnv::view_at`]).
+    pub fn trained_view(policy: &Policy, path: &Path) -> Result<View, CheckpointError> {
+        trained_view(policy, path, "1 (CubeRotEnv)", 61, CubeRotEnv::view_at)
     }
 }
 
@@ -297,7 +290,7 @@ fn wrong_goal_size(path: &Path, stage: &str, expected: &str, size: usize) -> Che
 impl Stage1 for PolicyStage1 {
     fn run(&mut self, sim: &mut Sim, position: [f64; 3], target: Quat, watch: Watch) -> StageRun {
         let goal = self.goal.desired(&pose_goal(position, target));
-        let (policy, sees_misalignment) = (&self.policy, self.sees_misalignment);
+        let (policy, view) = (&self.policy, self.view);
         let reached = pose_reached(self.goal);
         let mut running = 0;
         let mut held = |sim: &Sim| {
@@ -316,8 +309,7 @@ impl Stage1 for PolicyStage1 {
             .map(|steadying| Steadier::new(steadying, position));
         let act = |sim: &Sim| {
             steadied_action(steadier.as_mut(), sim, || {
-                let seen = sees_misalignment.then(|| cube_misalignment(sim));
-                policy.act(&rot_observation(sim, seen), &goal)
+                policy.act(&rot_observation(sim, view, None), &goal)
             })
         };
         drive(
@@ -338,9 +330,9 @@ pub struct PolicyStage2 {
     /// The success test the policy was trained on, whose desired goal it is given: the
     /// paper's, or one that also needs the cube left square.
     pub goal: LayerGoal,
-    /// Whether the policy was trained seeing the cube's misalignment as well
-    /// ([`CubeLayer::seeing_misalignment`]).
-    pub sees_misalignment: bool,
+    /// What the policy was trained to see beyond the paper's observations
+    /// ([`CubeLayer::with_view`]).
+    pub view: View,
     pub resting_z: f64,
     pub driving: Driving,
 }
@@ -360,36 +352,29 @@ impl PolicyStage2 {
         })
     }
 
-    /// Whether a Stage 2 policy (loaded from `path`) sees the cube's misalignment, told by
-    /// the size of its observation input: 62, the paper's view; 63, the misalignment too.
-    pub fn trained_view(policy: &Policy, path: &Path) -> Result<bool, CheckpointError> {
-        trained_view(
-            policy,
-            path,
-            "2 (LayerOpEnv)",
-            62,
-            CubeLayer::sees_misalignment_at,
-        )
+    /// What a Stage 2 policy (loaded from `path`) sees, told by the size of its observation
+    /// input ([`CubeLayer::view_at`]).
+    pub fn trained_view(policy: &Policy, path: &Path) -> Result<View, CheckpointError> {
+        trained_view(policy, path, "2 (LayerOpEnv)", 62, CubeLayer::view_at)
     }
 }
 
-/// Whether a policy (loaded from `path`) for `stage` sees the cube's misalignment, as
-/// `sees_at` tells from the size of its observation input: `plain`, the paper's view; one
-/// more, the misalignment too.
+/// What a policy (loaded from `path`) for `stage` sees, as `view_at` tells from the size of
+/// its observation input: `paper` numbers, or more for a view beyond the paper's.
 fn trained_view(
     policy: &Policy,
     path: &Path,
     stage: &str,
-    plain: usize,
-    sees_at: fn(usize) -> Option<bool>,
-) -> Result<bool, CheckpointError> {
+    paper: usize,
+    view_at: fn(usize) -> Option<View>,
+) -> Result<View, CheckpointError> {
     let size = policy.card.dims.observation;
-    sees_at(size).ok_or_else(|| CheckpointError::Mismatch {
+    view_at(size).ok_or_else(|| CheckpointError::Mismatch {
         path: path.to_path_buf(),
         message: format!(
-            "a Stage {stage} policy observes {plain} numbers ({} with the cube's misalignment), \
-             this one {size}: pass a policy trained for that stage",
-            plain + 1
+            "a Stage {stage} policy observes {paper} numbers (one more with the cube's \
+             misalignment, six more with the grip), this one {size}: pass a policy trained \
+             for that stage"
         ),
     })
 }
@@ -406,7 +391,7 @@ impl Stage2 for PolicyStage2 {
         let Some(view) = CubeLayer::start(sim, UP, rotation::IDENTITY) else {
             return StageRun::default();
         };
-        let mut view = view.seeing_misalignment(self.sees_misalignment);
+        let mut view = view.with_view(self.view);
         let goal = self.goal.desired(FRAC_PI_2);
         let policy = &self.policy;
         drive(

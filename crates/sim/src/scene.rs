@@ -105,6 +105,29 @@ pub struct JointAddress {
     pub dof: usize,
 }
 
+/// The parts of the hand whose grip on the object [`crate::Sim::grip`] reports, each named by
+/// the body its subtree starts at: the thumb, the four fingers (the little finger from its
+/// metacarpal), and the palm less the fingers.
+pub const GRIP_PARTS: [&str; 6] = [
+    "robot0:thbase",
+    "robot0:ffknuckle",
+    "robot0:mfknuckle",
+    "robot0:rfknuckle",
+    "robot0:lfmetacarpal",
+    "robot0:palm",
+];
+
+/// What a geom belongs to, for reading the hand's grip from the contacts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum GeomOwner {
+    /// The hand, in the part at this index of [`GRIP_PARTS`].
+    Hand(usize),
+    /// The object on the palm (any of its bodies).
+    Object,
+    /// Anything else (the forearm, the floor, the ghost target).
+    Other,
+}
+
 /// A compiled scene, shared by every simulation of it.
 pub struct Scene {
     kind: SceneKind,
@@ -114,6 +137,7 @@ pub struct Scene {
     ctrl_centre: [f64; HAND_ACTUATORS],
     ctrl_half_range: [f64; HAND_ACTUATORS],
     object: ObjectJoints,
+    geom_owners: Vec<GeomOwner>,
 }
 
 impl Scene {
@@ -175,6 +199,23 @@ impl Scene {
                 )?,
             },
         };
+        let object_body = model.jnt_bodyid()[lookup.id(
+            MjtObjBase::mjOBJ_JOINT,
+            "joint",
+            match kind {
+                SceneKind::Cube => "cube:joint",
+                SceneKind::Rot | SceneKind::Layer => "object:joint",
+            },
+        )?] as usize;
+        let grip_parts = GRIP_PARTS
+            .iter()
+            .map(|name| lookup.id(MjtObjBase::mjOBJ_BODY, "body", name))
+            .collect::<Result<Vec<_>, _>>()?;
+        let geom_owners = model
+            .geom_bodyid()
+            .iter()
+            .map(|&body| geom_owner(&model, body as usize, object_body, &grip_parts))
+            .collect();
         Ok(Arc::new(Scene {
             kind,
             path,
@@ -183,7 +224,13 @@ impl Scene {
             ctrl_centre,
             ctrl_half_range,
             object,
+            geom_owners,
         }))
+    }
+
+    /// What each geom belongs to, by geom id.
+    pub(crate) fn geom_owners(&self) -> &[GeomOwner] {
+        &self.geom_owners
     }
 
     pub fn kind(&self) -> SceneKind {
@@ -258,6 +305,27 @@ impl Lookup<'_> {
             qpos: self.model.jnt_qposadr()[id] as usize,
             dof: self.model.jnt_dofadr()[id] as usize,
         })
+    }
+}
+
+/// What a geom on `body` belongs to: the object if `object_body` is the body or an ancestor
+/// of it; otherwise the hand's part whose starting body in `grip_parts` is its nearest such
+/// ancestor (the palm holds the fingers' roots, so the nearest one decides); otherwise other.
+fn geom_owner(model: &MjModel, body: usize, object_body: usize, grip_parts: &[usize]) -> GeomOwner {
+    let parents = model.body_parentid();
+    let mut hand_part = None;
+    let mut at = body;
+    loop {
+        if at == object_body {
+            return GeomOwner::Object;
+        }
+        if hand_part.is_none() {
+            hand_part = grip_parts.iter().position(|&part| part == at);
+        }
+        if at == 0 {
+            return hand_part.map_or(GeomOwner::Other, GeomOwner::Hand);
+        }
+        at = parents[at] as usize;
     }
 }
 

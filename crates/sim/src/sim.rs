@@ -1,6 +1,6 @@
 //! One running simulation of a scene: its own `MjData` over the scene's shared model, a
 //! control step of 20 physics substeps, blow-up detection, and the state every environment
-//! reads (hand joints, the object's pose and velocities).
+//! reads (hand joints, the object's pose and velocities, the hand's grip on it).
 
 use std::sync::Arc;
 
@@ -9,7 +9,7 @@ use mujoco_rs::prelude::*;
 
 use crate::error::SimError;
 use crate::rotation::Quat;
-use crate::scene::{HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene};
+use crate::scene::{GRIP_PARTS, GeomOwner, HAND_ACTUATORS, HAND_JOINTS, JointAddress, Scene};
 
 /// Physics substeps of 0.002 s per control step, as in Gymnasium-Robotics' hand envs.
 pub const SUBSTEPS: usize = 20;
@@ -244,6 +244,27 @@ impl Sim {
         let dof = self.scene.object().free().dof;
         let v = &self.data.qvel()[dof..dof + 6];
         ([v[0], v[1], v[2]], [v[3], v[4], v[5]])
+    }
+
+    /// The hand's grip on the object: the normal force (N) with which each of the hand's
+    /// [`GRIP_PARTS`] presses on it, summed over their contacts, as the constraint solver
+    /// found them in the last physics substep (zero where a part does not touch it).
+    pub fn grip(&self) -> [f64; GRIP_PARTS.len()] {
+        let owners = self.scene.geom_owners();
+        let owner = |geom: i32| usize::try_from(geom).map_or(GeomOwner::Other, |g| owners[g]);
+        let mut grip = [0.0; GRIP_PARTS.len()];
+        for (id, contact) in self.data.contact().iter().enumerate() {
+            if contact.efc_address < 0 {
+                continue;
+            }
+            let part = match (owner(contact.geom[0]), owner(contact.geom[1])) {
+                (GeomOwner::Hand(part), GeomOwner::Object)
+                | (GeomOwner::Object, GeomOwner::Hand(part)) => part,
+                _ => continue,
+            };
+            grip[part] += self.data.contact_force(id)[0];
+        }
+        grip
     }
 
     /// A joint's quaternion coordinates (a ball or free joint's orientation part).

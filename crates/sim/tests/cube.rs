@@ -288,3 +288,50 @@ fn a_restored_physics_state_continues_exactly() {
     );
     assert_eq!(restored.physics_state(), before, "left as it was");
 }
+
+/// The cube's weight, newtons.
+fn cube_weight(sim: &Sim) -> f64 {
+    let model = sim.scene().model();
+    let body = model
+        .name_to_id(
+            mujoco_rs::wrappers::mj_model::MjtObjBase::mjOBJ_BODY,
+            "cubelet:DBL",
+        )
+        .expect("the cube's root body");
+    model.body_subtreemass()[body] * 9.81
+}
+
+/// The grip readout: the palm bears a cube resting on it, a closed hand presses with its
+/// fingers too, and a cube away from the hand has no grip at all.
+#[test]
+fn the_grip_shows_what_of_the_hand_presses_on_the_cube() {
+    let mut sim = Sim::new(Scene::load(SceneKind::Cube).expect("run scripts/setup first"));
+    let weight = cube_weight(&sim);
+    sim.set_action(&[0.0; dexcube_sim::HAND_ACTUATORS]);
+    settle(&mut sim, 10);
+    let resting = sim.grip();
+    let palm = dexcube_sim::GRIP_PARTS.len() - 1;
+    let borne: f64 = resting.iter().sum();
+    assert!(resting[palm] > 0.0, "the palm bears it: {resting:?}");
+    assert!(
+        (0.5 * weight..2.0 * weight).contains(&borne),
+        "about its weight, {weight} N: {resting:?}"
+    );
+    sim.set_action(&[1.0; dexcube_sim::HAND_ACTUATORS]);
+    settle(&mut sim, 10);
+    let closed = sim.grip();
+    assert!(
+        closed.iter().all(|&force| force > 0.0),
+        "every part presses: {closed:?}"
+    );
+    assert!(
+        closed.iter().sum::<f64>() > 5.0 * borne,
+        "harder than resting: {closed:?}"
+    );
+    let away = cube_sim().grip();
+    assert_eq!(
+        away,
+        [0.0; dexcube_sim::GRIP_PARTS.len()],
+        "away from the hand"
+    );
+}
