@@ -1,7 +1,6 @@
 //! What CubeRotEnv and LayerOpEnv share: the hand with an object on its palm, the first 61
 //! observations and what a policy may be shown beyond its stage's ([`View`]), placing the
-//! object at reset, the drop test, and turning a goal's verdict
-//! into a `Transition`.
+//! object at reset, the drop test, and turning a goal's verdict into a `Transition`.
 
 use std::sync::Arc;
 
