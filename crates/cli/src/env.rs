@@ -183,7 +183,9 @@ impl EnvChoice {
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
         let square = if self.square()? { ", left square" } else { "" };
-        let seen = (self.view()?.name())
+        let seen = self
+            .view()?
+            .name()
             .map(|name| format!(", {name} seen"))
             .unwrap_or_default();
         Ok(match self.named_object()? {

@@ -150,15 +150,14 @@ impl CubeLayer {
         self
     }
 
-    /// The view of a Stage 2 policy whose observation has `size` inputs (62 the paper's, 63
-    /// with the misalignment, 68 with the grip, 69 with both); `None` for any other size.
-    pub fn view_at(size: usize) -> Option<View> {
-        View::after(BASE_OBSERVATION + 1, size)
-    }
+    /// How many numbers Stage 2 observes without a view beyond the paper's (the 61, then the
+    /// layer angle); a trained policy's view is told from how many more it takes
+    /// ([`View::after`]: 63 with the misalignment, 68 with the grip, 69 with both).
+    pub const PAPER_OBSERVATION: usize = BASE_OBSERVATION + 1;
 
     /// How many inputs this view gives the policy.
     pub fn observation_size(&self) -> usize {
-        BASE_OBSERVATION + 1 + self.view.size()
+        CubeLayer::PAPER_OBSERVATION + self.view.size()
     }
 
     /// The same count, as if the layer had already turned by `turned` (a recorded start
@@ -455,7 +454,7 @@ impl GoalEnv for LayerOpEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
             observation: match &self.layer {
-                Layer::Block { .. } => BASE_OBSERVATION + 1,
+                Layer::Block { .. } => CubeLayer::PAPER_OBSERVATION,
                 Layer::Cube(tracker) => tracker.observation_size(),
             },
             goal: self.goal.size(),

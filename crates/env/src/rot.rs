@@ -126,11 +126,10 @@ impl CubeRotEnv {
         self
     }
 
-    /// The view of a Stage 1 policy whose observation has `size` inputs (61 the paper's, 62
-    /// with the misalignment, 67 with the grip, 68 with both); `None` for any other size.
-    pub fn view_at(size: usize) -> Option<View> {
-        View::after(BASE_OBSERVATION, size)
-    }
+    /// How many numbers Stage 1 observes without a view beyond the paper's; a trained
+    /// policy's view is told from how many more it takes ([`View::after`]: 62 with the
+    /// misalignment, 67 with the grip, 68 with both).
+    pub const PAPER_OBSERVATION: usize = BASE_OBSERVATION;
 
     /// Sets the goal pose (position, then quaternion) for the episode under way.
     pub fn set_desired_goal(&mut self, desired: &[f64]) {
@@ -226,7 +225,7 @@ impl SimulatedEnv for CubeRotEnv {
 impl GoalEnv for CubeRotEnv {
     fn spaces(&self) -> Spaces {
         Spaces {
-            observation: BASE_OBSERVATION + self.view.size(),
+            observation: CubeRotEnv::PAPER_OBSERVATION + self.view.size(),
             goal: self.goal.size(),
             action: dexcube_sim::HAND_ACTUATORS,
         }

@@ -347,7 +347,7 @@ fn a_layer_op_env_that_sees_the_misalignment_observes_the_achieved_one() {
             .with_goal(LayerGoal::square())
             .with_view(seeing(sees, false))
     };
-    assert_views_told_by_size(CubeLayer::view_at, 62);
+    assert_views_told_by_size(CubeLayer::PAPER_OBSERVATION, 62);
     assert_the_last_observation_is_the_misalignment(&mut make(false), &mut make(true), 62);
     let block = std::panic::catch_unwind(|| {
         LayerOpEnv::new(ObjectKind::Block, LayerMove::UPrime, LayerGoals::Evaluation)
@@ -362,11 +362,13 @@ fn seeing(misalignment: bool, grip: bool) -> View {
     View { misalignment, grip }
 }
 
-/// `view_at` tells each view from an observation of `paper` numbers and what the view adds
-/// (one for the misalignment, six for the grip), and no view from any other size near them.
-fn assert_views_told_by_size(view_at: fn(usize) -> Option<View>, paper: usize) {
+/// A stage whose paper observation has `stage_paper` numbers, `paper` of them, tells each view
+/// from that and what the view adds (one for the misalignment, six for the grip), and no view
+/// from any other size near them.
+fn assert_views_told_by_size(stage_paper: usize, paper: usize) {
+    assert_eq!(stage_paper, paper);
     let told = (paper - 2..paper + 10)
-        .filter_map(|size| view_at(size).map(|view| (size - paper, view)))
+        .filter_map(|size| View::after(stage_paper, size).map(|view| (size - paper, view)))
         .collect::<Vec<_>>();
     assert_eq!(
         told,
@@ -388,7 +390,7 @@ fn a_cube_rot_env_that_sees_the_misalignment_observes_the_achieved_one() {
         CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Pair).left_square())
             .with_view(seeing(sees, false))
     };
-    assert_views_told_by_size(CubeRotEnv::view_at, 61);
+    assert_views_told_by_size(CubeRotEnv::PAPER_OBSERVATION, 61);
     assert_the_last_observation_is_the_misalignment(&mut make(false), &mut make(true), 61);
     let rigid = std::panic::catch_unwind(|| {
         CubeRotEnv::new(RotMode::Paper)

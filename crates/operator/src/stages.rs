@@ -270,9 +270,14 @@ impl PolicyStage1 {
     }
 
     /// What a Stage 1 policy (loaded from `path`) sees, told by the size of its observation
-    /// input ([`CubeRotEnv::view_at`]).
+    /// input beyond [`CubeRotEnv::PAPER_OBSERVATION`].
     pub fn trained_view(policy: &Policy, path: &Path) -> Result<View, CheckpointError> {
-        trained_view(policy, path, "1 (CubeRotEnv)", 61, CubeRotEnv::view_at)
+        trained_view(
+            policy,
+            path,
+            "1 (CubeRotEnv)",
+            CubeRotEnv::PAPER_OBSERVATION,
+        )
     }
 }
 
@@ -353,23 +358,22 @@ impl PolicyStage2 {
     }
 
     /// What a Stage 2 policy (loaded from `path`) sees, told by the size of its observation
-    /// input ([`CubeLayer::view_at`]).
+    /// input beyond [`CubeLayer::PAPER_OBSERVATION`].
     pub fn trained_view(policy: &Policy, path: &Path) -> Result<View, CheckpointError> {
-        trained_view(policy, path, "2 (LayerOpEnv)", 62, CubeLayer::view_at)
+        trained_view(policy, path, "2 (LayerOpEnv)", CubeLayer::PAPER_OBSERVATION)
     }
 }
 
-/// What a policy (loaded from `path`) for `stage` sees, as `view_at` tells from the size of
-/// its observation input: `paper` numbers, or more for a view beyond the paper's.
+/// What a policy (loaded from `path`) for `stage` sees, told from the size of its observation
+/// input: the stage's `paper` numbers, or more for a view beyond the paper's.
 fn trained_view(
     policy: &Policy,
     path: &Path,
     stage: &str,
     paper: usize,
-    view_at: fn(usize) -> Option<View>,
 ) -> Result<View, CheckpointError> {
     let size = policy.card.dims.observation;
-    view_at(size).ok_or_else(|| CheckpointError::Mismatch {
+    View::after(paper, size).ok_or_else(|| CheckpointError::Mismatch {
         path: path.to_path_buf(),
         message: format!(
             "a Stage {stage} policy observes {paper} numbers (one more with the cube's \

@@ -117,7 +117,8 @@ pub const GRIP_PARTS: [&str; 6] = [
     "robot0:palm",
 ];
 
-/// What a geom belongs to, for reading the hand's grip from the contacts.
+/// What a body, and so each of its geoms, belongs to, for reading the hand's grip from the
+/// contacts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum GeomOwner {
     /// The hand, in the part at this index of [`GRIP_PARTS`].
@@ -199,22 +200,16 @@ impl Scene {
                 )?,
             },
         };
-        let object_body = model.jnt_bodyid()[lookup.id(
-            MjtObjBase::mjOBJ_JOINT,
-            "joint",
-            match kind {
-                SceneKind::Cube => "cube:joint",
-                SceneKind::Rot | SceneKind::Layer => "object:joint",
-            },
-        )?] as usize;
         let grip_parts = GRIP_PARTS
             .iter()
             .map(|name| lookup.id(MjtObjBase::mjOBJ_BODY, "body", name))
             .collect::<Result<Vec<_>, _>>()?;
+        let object_body = model.dof_bodyid()[object.free().dof] as usize;
+        let body_owners = body_owners(&model, object_body, &grip_parts);
         let geom_owners = model
             .geom_bodyid()
             .iter()
-            .map(|&body| geom_owner(&model, body as usize, object_body, &grip_parts))
+            .map(|&body| body_owners[body as usize])
             .collect();
         Ok(Arc::new(Scene {
             kind,
@@ -308,25 +303,26 @@ impl Lookup<'_> {
     }
 }
 
-/// What a geom on `body` belongs to: the object if `object_body` is the body or an ancestor
-/// of it; otherwise the hand's part whose starting body in `grip_parts` is its nearest such
-/// ancestor (the palm holds the fingers' roots, so the nearest one decides); otherwise other.
-fn geom_owner(model: &MjModel, body: usize, object_body: usize, grip_parts: &[usize]) -> GeomOwner {
+/// What each body belongs to, by body id: `object_body` and the bodies below it are the
+/// object; a body in `grip_parts` starts that hand part, and the bodies below it belong to the
+/// nearest such start above them (the palm holds the fingers' roots); the rest are other.
+/// MuJoCo numbers a parent before its children, so one pass in order suffices.
+fn body_owners(model: &MjModel, object_body: usize, grip_parts: &[usize]) -> Vec<GeomOwner> {
     let parents = model.body_parentid();
-    let mut hand_part = None;
-    let mut at = body;
-    loop {
-        if at == object_body {
-            return GeomOwner::Object;
-        }
-        if hand_part.is_none() {
-            hand_part = grip_parts.iter().position(|&part| part == at);
-        }
-        if at == 0 {
-            return hand_part.map_or(GeomOwner::Other, GeomOwner::Hand);
-        }
-        at = parents[at] as usize;
+    let mut owners = Vec::with_capacity(parents.len());
+    for body in 0..parents.len() {
+        let owner = if body == object_body {
+            GeomOwner::Object
+        } else if let Some(part) = grip_parts.iter().position(|&start| start == body) {
+            GeomOwner::Hand(part)
+        } else if body == 0 {
+            GeomOwner::Other
+        } else {
+            owners[parents[body] as usize]
+        };
+        owners.push(owner);
     }
+    owners
 }
 
 fn collect_array<const N: usize>(
