@@ -554,14 +554,15 @@ fn train_refuses_settings_it_cannot_run() {
 }
 
 /// A policy of either stage warm-started onto a view beyond the paper's gains its inputs
-/// (Stage 2 the cube's misalignment: 63 observations; Stage 1 that and the grip: 68; the
-/// shipped ones kept), and `eval-stage` and the operator give it that view, told by its size;
+/// (Stage 2 the cube's misalignment: 63 observations, from `layer-anchor69`'s 62; Stage 1 that
+/// and the grip: 68, from the shipped 61; the policy's own kept), and `eval-stage` and the operator give it that view, told by its size;
 /// `eval-stage` on the other object (the rigid cube, the block), which the views are not
 /// for, refuses it cleanly.
 #[test]
 fn a_policy_trained_seeing_more_is_evaluated_with_it() {
-    for (stage, view, env_args, observation, seen, other_object) in [
+    for (stage, init, view, env_args, observation, seen, other_object) in [
         (
+            "rot",
             "rot",
             &["--see-misalignment", "--see-grip"][..],
             &["--mode", "pair"][..],
@@ -571,6 +572,7 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
         ),
         (
             "layer",
+            "layer-anchor69",
             &["--see-misalignment"],
             &["--quarter-goals"],
             63,
@@ -580,7 +582,7 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
     ] {
         let dir = std::env::temp_dir().join(format!("dexcube-cli-see-more-{stage}"));
         let _ = std::fs::remove_dir_all(&dir);
-        let init = models().join(stage);
+        let init = models().join(init);
         let (init, out) = (init.to_str().unwrap(), dir.to_str().unwrap());
         let train = ["train", stage, "--object", "cube", "--square"];
         let o = dexcube(
@@ -698,9 +700,11 @@ fn train_resumes_only_with_the_starts_it_began_with() {
 fn eval_stage_records_each_object_under_its_own_name() {
     let dir = std::env::temp_dir().join("dexcube-cli-eval-stage");
     std::fs::create_dir_all(&dir).unwrap();
+    // A Stage 2 with the paper's view, which both objects can show (the shipped one also
+    // sees the cube's misalignment, which only the physical cube has).
     for ext in ["json", "safetensors"] {
         std::fs::copy(
-            models().join("layer").with_extension(ext),
+            models().join("layer-anchor69").with_extension(ext),
             dir.join("layer").with_extension(ext),
         )
         .unwrap();
@@ -738,7 +742,7 @@ fn eval_stage_records_each_object_under_its_own_name() {
     let card: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("layer.json")).unwrap()).unwrap();
     let metadata = &card["metadata"];
-    // The shipped Stage 2 was trained on the physical cube: the block is the other object.
+    // It was trained on the physical cube: the block is the other object.
     assert_eq!(metadata["environment"]["object"], "cube");
     assert_eq!(metadata["evaluation"]["episodes"], 2);
     let command = metadata["evaluation"]["command"].as_str().unwrap();
