@@ -660,7 +660,9 @@ fn a_recorded_stage_1_start_replays_the_operators_run_exactly() {
         starts: starts.into(),
         pick: StartPick::Numbered,
     };
-    let mut env = CubeRotEnv::with_scene(scene, stages.stage1.goal).with_starts(Some(mix));
+    let mut env = CubeRotEnv::with_scene(scene, stages.stage1.goal)
+        .with_view(stages.stage1.view)
+        .with_starts(Some(mix));
     replay(&mut env, &stages.stage1.policy);
     assert_eq!(env.sim().object_pose(), sim.object_pose());
     assert_eq!(env.sim().hand_angles(), sim.hand_angles());
@@ -738,10 +740,11 @@ fn replay(env: &mut dyn SimulatedEnv, policy: &dexcube_rl::Policy) {
     }
 }
 
-/// The same for Stage 2: a LayerOpEnv U' reset from a recorded Stage 2 start and run with the
-/// same policy ends exactly where the operator's Stage 2 did, and the start is marked failed
-/// exactly when the layer did not end a quarter turn round (within 0.1 rad) with the cube in
-/// its good state.
+/// The same for Stage 2: a LayerOpEnv U' with the policy's view (the shipped one sees the
+/// cube's misalignment), reset from a recorded Stage 2 start and run with the same policy,
+/// ends exactly where the operator's Stage 2 did, and the start is marked failed exactly when
+/// the layer did not end a quarter turn round (within 0.1 rad) with the cube in its good
+/// state.
 #[test]
 fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
     let (mut stages, _, scene, mut sim) = solved_cube_on_a_bent_hand();
@@ -760,6 +763,7 @@ fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
     };
     let mut env = LayerOpEnv::with_scene(scene, LayerMove::UPrime, LayerGoals::Evaluation)
         .with_goal(stages.stage2.goal)
+        .with_view(stages.stage2.view)
         .with_starts(Some(mix));
     replay(&mut env, &stages.stage2.policy);
     assert_eq!(env.sim().object_pose(), sim.object_pose());
