@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::{Context, bail};
 use clap::Args;
-use dexcube_cube::{CostTable, DistanceTable, scrambles_at_distance};
+use dexcube_cube::{CostTable, DistanceTable, Facelets, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
     CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RecordedStart,
@@ -23,7 +23,8 @@ use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_rl::start_file::{StartsOrigin, save_starts};
-use dexcube_sim::{Scene, SceneKind};
+use dexcube_sim::cube::CubeState;
+use dexcube_sim::{Scene, SceneKind, Sim};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::env::{EnvKind, original_object, starts_for, suited};
@@ -742,6 +743,8 @@ fn meets_paper_test(info: &Info, (position, angle): (f64, f64)) -> bool {
 struct EpisodeTrace {
     info: Info,
     square: bool,
+    /// The physical cube ended with a layer turned from where it began.
+    turned_a_layer: bool,
     longest_hold: usize,
     /// Where the episode began, when asked for (a fresh reset's).
     start: Option<RecordedStart>,
@@ -757,6 +760,7 @@ fn episode(
 ) -> EpisodeTrace {
     let (mut obs, _) = env.reset(Some(seed));
     let start = record.then(|| env.fresh_start());
+    let puzzle_at_start = puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
@@ -769,6 +773,7 @@ fn episode(
         if t.terminated || t.truncated {
             return EpisodeTrace {
                 square: is_square(env.sim()),
+                turned_a_layer: turned_a_layer(puzzle_at_start.as_ref(), env.sim()),
                 info: t.info,
                 longest_hold,
                 start,
@@ -776,6 +781,19 @@ fn episode(
         }
         obs = t.observation;
     }
+}
+
+/// The physical cube's puzzle: its stickers in its own frame, which a turn of the whole cube
+/// leaves as they are and a turn of any layer changes; `None` off the cube scene, or with a
+/// cubelet too far between positions to read.
+fn puzzle(sim: &Sim) -> Option<Facelets> {
+    CubeState::read(sim)?.facelets_in_cube_frame().ok()
+}
+
+/// Whether the cube in `sim` has a layer turned from the puzzle `start` (false if either
+/// cannot be read): what Stage 1, which only re-poses the cube, must never do.
+fn turned_a_layer(start: Option<&Facelets>, sim: &Sim) -> bool {
+    start.is_some_and(|start| puzzle(sim).is_some_and(|now| now != *start))
 }
 
 /// Holds of at least this many control steps are counted in `eval-stage`'s report: what a
@@ -791,6 +809,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let endings: [AtomicUsize; 7] = Default::default();
     let held: [AtomicUsize; HOLDS.len()] = Default::default();
     let wins_out_of_square = AtomicUsize::new(0);
+    // Stage 1 episodes that kept the cube and ended with a layer turned: (all, successes).
+    let layer_turns = [AtomicUsize::new(0), AtomicUsize::new(0)];
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
         EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
@@ -890,6 +910,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             if ending == Ending::Success && !trace.square {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
             }
+            if !turning && ending != Ending::Dropped && trace.turned_a_layer {
+                layer_turns[0].fetch_add(1, Ordering::Relaxed);
+                if ending == Ending::Success {
+                    layer_turns[1].fetch_add(1, Ordering::Relaxed);
+                }
+            }
             for (count, steps) in held.iter().zip(HOLDS) {
                 if trace.longest_hold >= steps {
                     count.fetch_add(1, Ordering::Relaxed);
@@ -936,6 +962,12 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     if wins_out_of_square > 0 {
         println!(
             "  successes that left the cube out of its good state (a cubelet over 0.1 rad off): {wins_out_of_square}"
+        );
+    }
+    if args.stage == EnvKind::Rot && object == ObjectKind::Cube {
+        let [turned, of_them_successes] = layer_turns.map(AtomicUsize::into_inner);
+        println!(
+            "  kept the cube but ended with a layer turned from where it began: {turned} ({of_them_successes} of them successes)"
         );
     }
     for (count, steps) in held.iter().zip(HOLDS) {
@@ -1041,6 +1073,32 @@ fn stage_command(args: &EvalStageArgs, object: ObjectKind, prefix: &Path) -> Str
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_turned_layer_is_told_from_a_turned_cube() {
+        let mut sim = Sim::new(Scene::load(SceneKind::Cube).expect("run scripts/setup first"));
+        sim.forward();
+        let start = puzzle(&sim).expect("a solved cube reads");
+        assert!(!turned_a_layer(Some(&start), &sim));
+        // The whole cube turned a quarter about x: re-posed, the same puzzle.
+        let mut pose = sim.object_pose();
+        pose.orientation =
+            dexcube_sim::rotation::about([1.0, 0.0, 0.0], std::f64::consts::FRAC_PI_2);
+        sim.set_object_pose(&pose);
+        sim.forward();
+        assert!(!turned_a_layer(Some(&start), &sim));
+        // A layer turned: a different puzzle, whichever way the cube is held.
+        assert!(dexcube_sim::cube::turn_face(
+            &mut sim,
+            dexcube_cube::Move::QUARTER_TURNS[0]
+        ));
+        sim.forward();
+        assert!(turned_a_layer(Some(&start), &sim));
+        // A start that could not be read counts no turn.
+        assert!(!turned_a_layer(None, &sim));
+        let rigid = Sim::new(Scene::load(SceneKind::Rot).unwrap());
+        assert!(!turned_a_layer(Some(&start), &rigid));
+    }
 
     #[test]
     fn stage_2_misses_that_never_turned_the_layer_are_told_apart() {
