@@ -85,6 +85,11 @@ pub struct EnvChoice {
     /// The paper's tests read only the pose (CubeRotEnv) or the turned layer (LayerOpEnv).
     #[arg(long)]
     pub square: bool,
+    /// CubeRotEnv on the physical cube only: success also needs the cube intact, no layer
+    /// turned from where it was when the episode began (a layer pushed a whole quarter round
+    /// leaves the cube square, but changes the puzzle). Implies --square.
+    #[arg(long)]
+    pub intact: bool,
     /// On the physical cube only: the observation gains the cube's misalignment (the largest
     /// angle of a cubelet off a quarter turn, in tenths of a radian), which the good state's
     /// test reads and the paper's observations (61 for CubeRotEnv, 62 for LayerOpEnv) do not
@@ -146,23 +151,47 @@ impl EnvChoice {
     /// Whether the success test needs the cube left square (`--square`, which only the
     /// physical cube can be asked for).
     pub fn square(&self) -> anyhow::Result<bool> {
-        if self.square && self.object()? != ObjectKind::Cube {
+        let square = self.square || self.intact()?;
+        if square && self.object()? != ObjectKind::Cube {
             bail!(
-                "--square is for the physical cube, whose layers can be left out of line: \
-                 add --object cube"
+                "{} is for the physical cube, whose layers can be left out of line: add \
+                 --object cube",
+                if self.square { "--square" } else { "--intact" }
             );
         }
-        Ok(self.square)
+        Ok(square)
+    }
+
+    /// Whether CubeRotEnv's success test needs the cube intact (`--intact`); LayerOpEnv's
+    /// turns a layer by design.
+    pub fn intact(&self) -> anyhow::Result<bool> {
+        if self.intact && self.env != EnvKind::Rot {
+            bail!(
+                "--intact is for CubeRotEnv (Stage 1), which re-poses the cube without turning a \
+                 layer; LayerOpEnv's task is to turn one"
+            );
+        }
+        Ok(self.intact)
     }
 
     /// CubeRotEnv's success test: the paper's in the chosen mode, or with `--square` the
-    /// good state as well.
+    /// good state as well, and with `--intact` no layer turned too.
     pub fn rot_goal(&self) -> anyhow::Result<RotGoal> {
         let paper = RotGoal::paper(self.mode);
-        Ok(if self.square()? {
-            paper.left_square()
-        } else {
-            paper
+        Ok(match (self.square()?, self.intact()?) {
+            (_, true) => paper.left_intact(),
+            (true, false) => paper.left_square(),
+            (false, false) => paper,
+        })
+    }
+
+    /// How the success test's name goes on after the stage's own part: ", left square", and
+    /// " and intact" with `--intact`.
+    pub fn success_suffix(&self) -> anyhow::Result<&'static str> {
+        Ok(match (self.square()?, self.intact()?) {
+            (_, true) => ", left square and intact",
+            (true, false) => ", left square",
+            (false, false) => "",
         })
     }
 
@@ -182,7 +211,7 @@ impl EnvChoice {
             EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
-        let square = if self.square()? { ", left square" } else { "" };
+        let square = self.success_suffix()?;
         let seen = self
             .view()?
             .name()
@@ -269,10 +298,10 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
         "  episode:     {} control steps of 20 x 0.002 s",
         dexcube_env::EPISODE_STEPS
     );
-    let square = if choice.square()? {
-        ", every cubelet within 0.1 rad of a quarter turn"
-    } else {
-        ""
+    let square = match (choice.square()?, choice.intact()?) {
+        (_, true) => ", every cubelet within 0.1 rad of a quarter turn, no layer turned",
+        (true, false) => ", every cubelet within 0.1 rad of a quarter turn",
+        (false, false) => "",
     };
     match choice.env {
         EnvKind::Rot => println!(

@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::{Context, bail};
 use clap::Args;
-use dexcube_cube::{CostTable, DistanceTable, Facelets, scrambles_at_distance};
+use dexcube_cube::{CostTable, DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
     CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RecordedStart,
@@ -23,8 +23,8 @@ use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_rl::start_file::{StartsOrigin, save_starts};
-use dexcube_sim::cube::CubeState;
-use dexcube_sim::{Scene, SceneKind, Sim};
+use dexcube_sim::cube::{read_puzzle, turned_since};
+use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::env::{EnvKind, original_object, starts_for, suited};
@@ -760,7 +760,7 @@ fn episode(
 ) -> EpisodeTrace {
     let (mut obs, _) = env.reset(Some(seed));
     let start = record.then(|| env.fresh_start());
-    let puzzle_at_start = puzzle(env.sim());
+    let puzzle_at_start = read_puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
@@ -773,7 +773,7 @@ fn episode(
         if t.terminated || t.truncated {
             return EpisodeTrace {
                 square: is_square(env.sim()),
-                turned_a_layer: turned_a_layer(puzzle_at_start.as_ref(), env.sim()),
+                turned_a_layer: turned_since(puzzle_at_start.as_ref(), env.sim()),
                 info: t.info,
                 longest_hold,
                 start,
@@ -781,19 +781,6 @@ fn episode(
         }
         obs = t.observation;
     }
-}
-
-/// The physical cube's puzzle: its stickers in its own frame, which a turn of the whole cube
-/// leaves as they are and a turn of any layer changes; `None` off the cube scene, or with a
-/// cubelet too far between positions to read.
-fn puzzle(sim: &Sim) -> Option<Facelets> {
-    CubeState::read(sim)?.facelets_in_cube_frame().ok()
-}
-
-/// Whether the cube in `sim` has a layer turned from the puzzle `start` (false if either
-/// cannot be read): what Stage 1, which only re-poses the cube, must never do.
-fn turned_a_layer(start: Option<&Facelets>, sim: &Sim) -> bool {
-    start.is_some_and(|start| puzzle(sim).is_some_and(|now| now != *start))
 }
 
 /// Holds of at least this many control steps are counted in `eval-stage`'s report: what a
@@ -1073,32 +1060,6 @@ fn stage_command(args: &EvalStageArgs, object: ObjectKind, prefix: &Path) -> Str
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_turned_layer_is_told_from_a_turned_cube() {
-        let mut sim = Sim::new(Scene::load(SceneKind::Cube).expect("run scripts/setup first"));
-        sim.forward();
-        let start = puzzle(&sim).expect("a solved cube reads");
-        assert!(!turned_a_layer(Some(&start), &sim));
-        // The whole cube turned a quarter about x: re-posed, the same puzzle.
-        let mut pose = sim.object_pose();
-        pose.orientation =
-            dexcube_sim::rotation::about([1.0, 0.0, 0.0], std::f64::consts::FRAC_PI_2);
-        sim.set_object_pose(&pose);
-        sim.forward();
-        assert!(!turned_a_layer(Some(&start), &sim));
-        // A layer turned: a different puzzle, whichever way the cube is held.
-        assert!(dexcube_sim::cube::turn_face(
-            &mut sim,
-            dexcube_cube::Move::QUARTER_TURNS[0]
-        ));
-        sim.forward();
-        assert!(turned_a_layer(Some(&start), &sim));
-        // A start that could not be read counts no turn.
-        assert!(!turned_a_layer(None, &sim));
-        let rigid = Sim::new(Scene::load(SceneKind::Rot).unwrap());
-        assert!(!turned_a_layer(Some(&start), &rigid));
-    }
 
     #[test]
     fn stage_2_misses_that_never_turned_the_layer_are_told_apart() {

@@ -274,6 +274,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 + &suffix
         }
     } + if square { "-square" } else { "" }
+        + if args.choice.intact()? { "-intact" } else { "" }
         + if view.misalignment { "-seen" } else { "" }
         + if view.grip { "-grip" } else { "" };
     let name = args.choice.env.name();
@@ -351,7 +352,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     EnvKind::Rot => "pose",
                     EnvKind::Layer => "angle",
                 },
-                if square { ", cube left square" } else { "" }
+                args.choice.success_suffix()?.replace(", left", ", cube left")
             ),
             "observation": view.name().map_or("paper".to_string(), |name| format!("with the {name}")),
             "object": object.name(),

@@ -530,6 +530,11 @@ fn train_refuses_settings_it_cannot_run() {
             "--failed-weight must be a positive number",
         ),
         (&["rot", "--failed-weight", "5"], "--starts <FILE>"),
+        (&["rot", "--intact"], "--intact is for the physical cube"),
+        (
+            &["layer", "--object", "cube", "--intact"],
+            "--intact is for CubeRotEnv",
+        ),
         (
             &["rot", "--object", "cube", "--starts", "/no/such/starts"],
             "record starts with `dexcube eval",

@@ -56,6 +56,13 @@ pub struct RotGoal {
     /// When set, success also needs every cubelet within this many radians of a
     /// quarter-turn position. The paper's test has none.
     pub square_threshold: Option<f64>,
+    /// With `square_threshold`, success also needs the cube intact: no layer turned from
+    /// where it was when the episode began. The environment, which knows that start, adds a
+    /// quarter turn (π/2) to the achieved misalignment once a layer has turned, so the same
+    /// last part of the goal carries both and a relabelled goal (HER) is judged alike. A
+    /// policy cannot tell from its goal's size whether it was trained so (its actor never
+    /// sees the achieved goal).
+    pub intact: bool,
 }
 
 /// Length of a pose goal: position 3, quaternion 4.
@@ -69,6 +76,7 @@ impl RotGoal {
             position_threshold: 0.01,
             angle_threshold: 0.1,
             square_threshold: None,
+            intact: false,
         }
     }
 
@@ -77,6 +85,14 @@ impl RotGoal {
         RotGoal {
             square_threshold: Some(ALIGNED_TOLERANCE),
             ..self
+        }
+    }
+
+    /// The same test, and the cube left in its good state with no layer turned.
+    pub fn left_intact(self) -> RotGoal {
+        RotGoal {
+            intact: true,
+            ..self.left_square()
         }
     }
 

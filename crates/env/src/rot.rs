@@ -7,6 +7,9 @@
 //! an eighth part, the cube's misalignment (desired 0), and success also needs the cube left
 //! in its good state, as LayerOpEnv's square test does: the paper's test reads only the pose,
 //! and a pose reached with a layer pushed part-way round must be restored before Stage 2.
+//! With [`RotGoal::left_intact`] it also needs no layer turned from where it began: a layer
+//! pushed a whole quarter round leaves the cube square but changes the puzzle, which spoils
+//! the rest of the operator's plan.
 //! On the physical cube the policy may also be shown more ([`CubeRotEnv::with_view`]): that
 //! misalignment (62), in units of the good state's tolerance, as LayerOpEnv's view can be, the
 //! part of the achieved goal that the 61 do not show; and the hand's grip on the cube (six
@@ -24,7 +27,8 @@
 
 use std::sync::Arc;
 
-use dexcube_sim::cube::CubeState;
+use dexcube_cube::Facelets;
+use dexcube_sim::cube::{CubeState, read_puzzle, turned_since};
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
@@ -58,6 +62,8 @@ pub struct CubeRotEnv {
     desired: Vec<f64>,
     starts: Option<StartMix>,
     view: View,
+    /// The cube's puzzle when the episode began, kept for a goal that needs it intact.
+    puzzle_at_start: Option<Facelets>,
 }
 
 impl CubeRotEnv {
@@ -79,6 +85,7 @@ impl CubeRotEnv {
             desired,
             starts: None,
             view: View::PAPER,
+            puzzle_at_start: None,
         }
     }
 
@@ -100,9 +107,20 @@ impl CubeRotEnv {
         Ok(self.first_observation())
     }
 
-    /// The episode's first observation and its info.
-    fn first_observation(&self) -> (Observation, Info) {
-        let observation = observe(&self.hand, &self.goal, &self.desired, self.view);
+    /// The episode's first observation and its info; notes the puzzle it begins with.
+    fn first_observation(&mut self) -> (Observation, Info) {
+        self.puzzle_at_start = self
+            .goal
+            .intact
+            .then(|| read_puzzle(&self.hand.sim))
+            .flatten();
+        let observation = observe(
+            &self.hand,
+            &self.goal,
+            &self.desired,
+            self.view,
+            self.puzzle_at_start.as_ref(),
+        );
         let info = self.hand.info(&observation, self.goal.as_ref(), None);
         (observation, info)
     }
@@ -154,14 +172,28 @@ impl CubeRotEnv {
 }
 
 /// The observations, with the cube's pose (observations 48 to 54) as the achieved goal, and
-/// with a goal that needs the good state, the cube's misalignment after it. The misalignment
-/// is read once, and only if the goal or the view needs it.
-fn observe(hand: &HandObject, goal: &RotGoal, desired: &[f64], view: View) -> Observation {
+/// with a goal that needs the good state, the cube's misalignment after it, a quarter turn
+/// more once a layer has turned from `puzzle_at_start` if the goal needs the cube intact.
+/// The misalignment is read once, and only if the goal or the view needs it.
+fn observe(
+    hand: &HandObject,
+    goal: &RotGoal,
+    desired: &[f64],
+    view: View,
+    puzzle_at_start: Option<&Facelets>,
+) -> Observation {
     let misalignment = (goal.square_threshold.is_some() || view.misalignment)
         .then(|| cube_misalignment(&hand.sim));
     let observation = rot_observation(&hand.sim, view, misalignment);
+    let turned = goal.intact && turned_since(puzzle_at_start, &hand.sim);
+    let achieved_misalignment = misalignment.unwrap_or(0.0)
+        + if turned {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            0.0
+        };
     Observation {
-        achieved_goal: goal.achieved(&observation[48..55], misalignment.unwrap_or(0.0)),
+        achieved_goal: goal.achieved(&observation[48..55], achieved_misalignment),
         desired_goal: goal.desired(desired),
         observation,
     }
@@ -186,7 +218,8 @@ pub fn cube_misalignment(sim: &Sim) -> f64 {
 
 /// CubeRotEnv's achieved goal for the cube in `sim` at `pose` (position, then quaternion with
 /// w ≥ 0): with a goal that needs the good state, the cube's misalignment after it, which is
-/// read only then.
+/// read only then. Without the episode's start it cannot tell a turned layer, so a goal
+/// that needs the cube intact is judged here as one that needs it square.
 pub fn achieved_goal(goal: &RotGoal, sim: &Sim, pose: &[f64]) -> Vec<f64> {
     let misalignment = match goal.square_threshold {
         Some(_) => cube_misalignment(sim),
@@ -252,8 +285,9 @@ impl GoalEnv for CubeRotEnv {
 
     fn step(&mut self, action: &[f64]) -> Transition {
         let (goal, desired, view) = (&self.goal, &self.desired, self.view);
+        let start = self.puzzle_at_start.as_ref();
         self.hand.step(action, goal.as_ref(), |hand| {
-            observe(hand, goal, desired, view)
+            observe(hand, goal, desired, view, start)
         })
     }
 }

@@ -545,6 +545,70 @@ fn a_pose_reached_left_square_needs_the_cube_in_its_good_state() {
     );
 }
 
+/// Stage 1 with the cube kept intact in its test: at the target pose and square it succeeds;
+/// with a side layer turned a whole quarter round, square again, it does not, and its
+/// achieved misalignment carries the turn (so a relabelled goal is judged alike), though the
+/// square test alone would pass it. A new episode starts from the puzzle it finds.
+#[test]
+fn a_pose_reached_intact_needs_no_layer_turned() {
+    let scene = Scene::load(ObjectKind::Cube.scene()).unwrap();
+    let intact = RotGoal::paper(RotMode::Pair).left_intact();
+    let mut env = CubeRotEnv::with_scene(scene, intact);
+    assert_eq!(
+        env.spaces().goal,
+        8,
+        "the same goal vector as the square test"
+    );
+    let at_target = |env: &mut CubeRotEnv, desired: &[f64]| {
+        let target = Pose {
+            position: env.resting_point(),
+            orientation: [desired[3], desired[4], desired[5], desired[6]],
+        };
+        env.sim_mut().set_object_pose(&target);
+        env.sim_mut().forward();
+        env.step(&[0.0; 20])
+    };
+    let (obs, _) = env.reset(Some(5));
+    let desired = obs.desired_goal;
+    let t = at_target(&mut env, &desired);
+    assert!(t.info.is_success, "at the pose, square and intact");
+    let side = face_toward(&env.sim().object_pose().orientation, [1.0, 0.0, 0.0]);
+    turn_face_by(env.sim_mut(), side, FRAC_PI_2);
+    let t = at_target(&mut env, &desired);
+    let a = &t.observation.achieved_goal;
+    let misalignment = CubeState::read(env.sim()).unwrap().misalignment();
+    assert!(
+        misalignment < ALIGNED_TOLERANCE,
+        "square again: {misalignment}"
+    );
+    assert!(
+        (a[7] - misalignment - FRAC_PI_2).abs() < 1e-12,
+        "the turn in the goal: {a:?}"
+    );
+    assert!(
+        !t.info.is_success && t.reward == -1.0,
+        "a layer turned: {a:?}"
+    );
+    assert!(
+        !env.goal().is_success(a, a),
+        "a turned cube is never a goal reached"
+    );
+    let square = RotGoal::paper(RotMode::Pair).left_square();
+    let mut a_square = a.clone();
+    a_square[7] = misalignment;
+    assert!(
+        square.is_success(&a_square, &desired),
+        "square alone passes it"
+    );
+    // The next episode's start is its own: a cube with that layer turned is intact there.
+    let (obs, _) = env.reset(Some(6));
+    assert!(
+        obs.achieved_goal[7] < ALIGNED_TOLERANCE,
+        "{:?}",
+        obs.achieved_goal
+    );
+}
+
 /// About one landing in ten on the flat hand knocks a layer of the physical cube out of its
 /// good state; such a start is set down again, so every episode starts with a turnable cube.
 #[test]

@@ -24,7 +24,7 @@
 
 use dexcube_cube::{CostTable, DistanceTable, Face, Facelets, Move, Position, Solver};
 use dexcube_env::is_square;
-use dexcube_sim::cube::{CubeState, snap_layers};
+use dexcube_sim::cube::{CubeState, read_puzzle, snap_layers};
 use dexcube_sim::{Pose, Sim};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -259,7 +259,7 @@ impl Operator<'_> {
     /// Solves the cube in `sim`, reporting each event to `narrate`.
     pub fn solve(&mut self, sim: &mut Sim, narrate: &mut dyn FnMut(&Event)) -> Outcome {
         let mut outcome = Outcome::default();
-        let Some(start) = read(sim) else {
+        let Some(start) = read_puzzle(sim) else {
             outcome.failure = Some(Failure::StuckMisaligned);
             return outcome;
         };
@@ -282,7 +282,7 @@ impl Operator<'_> {
                 continue;
             }
             // Check that the move happened; if not, re-plan from what is there.
-            match read(sim) {
+            match read_puzzle(sim) {
                 Some(seen) if Position::of(&seen) == Position::of(&expected) => {
                     narrate(&Event::MoveDone(m))
                 }
@@ -424,11 +424,6 @@ impl Operator<'_> {
         }
         None
     }
-}
-
-/// The cube's stickers in its own frame, if they can be read.
-fn read(sim: &Sim) -> Option<Facelets> {
-    CubeState::read(sim)?.facelets_in_cube_frame().ok()
 }
 
 /// Places a scrambled cube on the palm: `scramble` turned kinematically from solved, at rest.

@@ -189,6 +189,19 @@ impl CubeState {
     }
 }
 
+/// The physical cube's puzzle in `sim`: its stickers in its own frame, which a turn of the
+/// whole cube leaves as they are and a turn of any layer changes. `None` off the cube scene,
+/// or with a cubelet too far between positions to read.
+pub fn read_puzzle(sim: &Sim) -> Option<Facelets> {
+    CubeState::read(sim)?.facelets_in_cube_frame().ok()
+}
+
+/// Whether the cube in `sim` has a layer turned from the puzzle `start` (false if either
+/// cannot be read): what a re-posing of the whole cube, Stage 1, must never do.
+pub fn turned_since(start: Option<&Facelets>, sim: &Sim) -> bool {
+    start.is_some_and(|start| read_puzzle(sim).is_some_and(|now| now != *start))
+}
+
 /// Turns one face of the cube in the physics by setting joint positions, as a perfect hand
 /// would; velocities of the moved joints are zeroed. Faces are named as seen in the world
 /// (U is the layer facing up, R the one facing +x, B the one facing +y), like

@@ -1,7 +1,7 @@
 //! The physical cube's readout against the `cube` crate: kinematic turns, tumbling, pushes.
 
 use dexcube_cube::{Face, Facelets, Move, parse_moves};
-use dexcube_sim::cube::{CubeState, turn_face, turn_face_by};
+use dexcube_sim::cube::{CubeState, read_puzzle, turn_face, turn_face_by, turned_since};
 use dexcube_sim::rotation::{self, about};
 use dexcube_sim::{Pose, Scene, SceneKind, Sim};
 
@@ -334,4 +334,24 @@ fn the_grip_shows_what_of_the_hand_presses_on_the_cube() {
         [0.0; dexcube_sim::GRIP_PARTS.len()],
         "away from the hand"
     );
+}
+
+/// A re-posed cube is the same puzzle; a turned layer is another, whichever way the cube is
+/// held; a start that could not be read, or a scene without the cube, counts no turn.
+#[test]
+fn a_turned_layer_is_told_from_a_turned_cube() {
+    let mut sim = cube_sim();
+    let start = read_puzzle(&sim).expect("a solved cube reads");
+    assert!(!turned_since(Some(&start), &sim));
+    let mut pose = read(&sim).pose();
+    pose.orientation = about([1.0, 0.0, 0.0], std::f64::consts::FRAC_PI_2);
+    sim.set_object_pose(&pose);
+    sim.forward();
+    assert!(!turned_since(Some(&start), &sim));
+    assert!(turn_face(&mut sim, Move::QUARTER_TURNS[0]));
+    sim.forward();
+    assert!(turned_since(Some(&start), &sim));
+    assert!(!turned_since(None, &sim));
+    let rigid = Sim::new(Scene::load(SceneKind::Rot).unwrap());
+    assert!(!turned_since(Some(&start), &rigid));
 }
