@@ -94,13 +94,17 @@ pub struct CubeResult {
 }
 
 impl CubeResult {
-    pub const CSV_HEADER: &'static str = "distance,index,rollback,solved,actions,randomisations,replans,control_steps,failure,stage1_runs,stage1_reached,stage2_runs,stage2_misaligned";
+    pub const CSV_HEADER: &'static str = "distance,index,rollback,solved,actions,randomisations,replans,control_steps,failure,stage1_runs,stage1_reached,stage2_runs,stage2_misaligned,stage1_turned";
 
     pub fn csv_row(&self) -> String {
-        let stages = self.stages.map_or(",,,".to_string(), |s| {
+        let stages = self.stages.map_or(",,,,".to_string(), |s| {
             format!(
-                "{},{},{},{}",
-                s.stage1_runs, s.stage1_reached, s.stage2_runs, s.stage2_misaligned
+                "{},{},{},{},{}",
+                s.stage1_runs,
+                s.stage1_reached,
+                s.stage2_runs,
+                s.stage2_misaligned,
+                s.stage1_turned.map_or(String::new(), |n| n.to_string())
             )
         });
         format!(
@@ -124,18 +128,22 @@ impl CubeResult {
         after.split(' ').next()?.parse().ok()
     }
 
-    /// A row of the CSV: 13 fields, or the 9 of rows written before the stages were
-    /// recorded.
+    /// A row of the CSV: 14 fields, the 13 of rows written before Stage 1's turned layers
+    /// were counted, or the 9 of rows written before the stages were recorded.
     pub fn from_csv(line: &str) -> Option<CubeResult> {
         let f: Vec<&str> = line.trim().split(',').collect();
         let stages = match f.len() {
             9 => None,
-            13 if f[9..].iter().all(|x| x.is_empty()) => None,
-            13 => Some(StageRecord {
+            13 | 14 if f[9..].iter().all(|x| x.is_empty()) => None,
+            13 | 14 => Some(StageRecord {
                 stage1_runs: f[9].parse().ok()?,
                 stage1_reached: f[10].parse().ok()?,
                 stage2_runs: f[11].parse().ok()?,
                 stage2_misaligned: f[12].parse().ok()?,
+                stage1_turned: match f.get(13) {
+                    None | Some(&"") => None,
+                    Some(n) => Some(n.parse().ok()?),
+                },
             }),
             _ => return None,
         };
@@ -299,8 +307,8 @@ pub fn markdown(rows: &[TableRow], results: &[CubeResult], command: &str) -> Str
 
 /// The atomic actions as they fared inside the attempts, for each variant, over the rows
 /// that record them (none: an empty string): how often Stage 1 reached its pose and how often
-/// Stage 2 left the cube out of its good state, and how often each dropped the cube, as
-/// shares of their runs.
+/// it turned a layer (where every row counted that), how often Stage 2 left the cube out of
+/// its good state, and how often each dropped the cube, as shares of their runs.
 fn stages_markdown(results: &[CubeResult]) -> String {
     let mut out = String::new();
     for (variant, rollback) in [("with rollback", true), ("open loop", false)] {
@@ -323,11 +331,16 @@ fn stages_markdown(results: &[CubeResult]) -> String {
         let runs2 = sum(|s| s.stage2_runs) + drops2;
         let share =
             |n: usize, of: usize| format!("{n} ({:.1}%)", 100.0 * n as f64 / of.max(1) as f64);
+        let turned = rows
+            .iter()
+            .map(|(_, s)| s.stage1_turned)
+            .sum::<Option<usize>>()
+            .map_or("not counted".to_string(), |n| share(n, runs1));
         if out.is_empty() {
-            out += "\nThe atomic actions inside the attempts (a run that dropped the cube or blew up the physics ended its attempt):\n\n| variant | cubes | Stage 1 runs | pose reached | dropped | Stage 2 runs | cube left out of its good state | dropped |\n|---|---|---|---|---|---|---|---|\n";
+            out += "\nThe atomic actions inside the attempts (a run that dropped the cube or blew up the physics ended its attempt):\n\n| variant | cubes | Stage 1 runs | pose reached | layer turned | dropped | Stage 2 runs | cube left out of its good state | dropped |\n|---|---|---|---|---|---|---|---|---|\n";
         }
         out += &format!(
-            "| {variant} | {} | {runs1} | {} | {} | {runs2} | {} | {} |\n",
+            "| {variant} | {} | {runs1} | {} | {turned} | {} | {runs2} | {} | {} |\n",
             rows.len(),
             share(sum(|s| s.stage1_reached), runs1),
             share(drops1, runs1),
@@ -470,8 +483,9 @@ mod tests {
         assert_eq!(CubeResult::from_csv(&line), Some(r(3, false, true, 9)));
     }
 
-    /// Rows record how the stages fared, rows from before that still read, and the table
-    /// sums the stages over the rows that have them.
+    /// Rows record how the stages fared, rows from before that (or from before Stage 1's
+    /// turned layers were counted) still read, and the table sums the stages over the rows
+    /// that have them, and the turned layers only where every row counted them.
     #[test]
     fn stage_records_round_trip_and_are_summed() {
         let old = "2,7,true,false,5,1,0,518,Dropped";
@@ -485,6 +499,7 @@ mod tests {
                 stage1_reached: 2,
                 stage2_runs: 4,
                 stage2_misaligned: 1,
+                stage1_turned: Some(1),
             }),
             ..row.clone()
         };
@@ -498,13 +513,21 @@ mod tests {
             failure: String::new(),
             ..recorded.clone()
         };
-        let text = stages_markdown(&[row, recorded, solved]);
+        let text = stages_markdown(&[row, recorded.clone(), solved.clone()]);
         assert!(
             text.contains(
-                "| with rollback | 2 | 7 | 4 (57.1%) | 1 (14.3%) | 8 | 2 (25.0%) | 0 (0.0%) |"
+                "| with rollback | 2 | 7 | 4 (57.1%) | 2 (28.6%) | 1 (14.3%) | 8 | 2 (25.0%) | 0 (0.0%) |"
             ),
             "{text}"
         );
+        let uncounted = CubeResult::from_csv("2,7,true,true,5,1,0,518,,3,2,4,1").unwrap();
+        assert_eq!(uncounted.stages.unwrap().stage1_turned, None);
+        assert_eq!(
+            CubeResult::from_csv(&uncounted.csv_row()),
+            Some(uncounted.clone())
+        );
+        let text = stages_markdown(&[recorded, uncounted]);
+        assert!(text.contains("| 4 (57.1%) | not counted |"), "{text}");
         assert!(!text.contains("open loop"));
         assert_eq!(stages_markdown(&[]), "");
     }

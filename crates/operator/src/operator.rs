@@ -24,7 +24,7 @@
 
 use dexcube_cube::{CostTable, DistanceTable, Face, Facelets, Move, Position, Solver};
 use dexcube_env::is_square;
-use dexcube_sim::cube::{CubeState, read_puzzle, snap_layers};
+use dexcube_sim::cube::{CubeState, read_puzzle, snap_layers, turned_since};
 use dexcube_sim::{Pose, Sim};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -65,16 +65,34 @@ pub struct Outcome {
 }
 
 /// How the atomic actions fared inside one attempt, as the operator saw them.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StageRecord {
     /// Stage 1 runs that kept the cube on the palm, and those after which the pose check
     /// passed (a run that dropped it ended the attempt, and `Outcome::failed_at` names it).
     pub stage1_runs: usize,
     pub stage1_reached: usize,
-    /// Stage 2 runs that kept the cube on the palm, and those that left it out of its good state (a layer part-way or
-    /// another layer knocked out of square), whether or not the rollback then restored it.
+    /// Stage 2 runs that kept the cube on the palm, and those that left it out of its good
+    /// state (a layer part-way or another layer knocked out of square), whether or not the
+    /// rollback then restored it.
     pub stage2_runs: usize,
     pub stage2_misaligned: usize,
+    /// Stage 1 runs that kept the cube but left a layer turned from where it was when the
+    /// run began (the puzzle changed, which the pose check does not see); `None` in records
+    /// from before it was counted.
+    pub stage1_turned: Option<usize>,
+}
+
+impl Default for StageRecord {
+    /// No runs yet, every count recorded.
+    fn default() -> StageRecord {
+        StageRecord {
+            stage1_runs: 0,
+            stage1_reached: 0,
+            stage2_runs: 0,
+            stage2_misaligned: 0,
+            stage1_turned: Some(0),
+        }
+    }
 }
 
 impl Outcome {
@@ -361,6 +379,7 @@ impl Operator<'_> {
             stage1_attempts = 0;
         }
         for attempt in 1..=stage1_attempts {
+            let puzzle_before = read_puzzle(sim);
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
             if let Some(failure) = outcome.count(1, &run) {
                 narrate(&Event::Ended { stage: 1, failure });
@@ -371,6 +390,9 @@ impl Operator<'_> {
             let ok = posed && square;
             outcome.stages.stage1_runs += 1;
             outcome.stages.stage1_reached += usize::from(posed);
+            let turned = turned_since(puzzle_before.as_ref(), sim);
+            let counted = &mut outcome.stages.stage1_turned;
+            *counted = counted.map(|n| n + usize::from(turned));
             narrate(&Event::Stage1 {
                 face: up,
                 landed: face_up(sim),

@@ -269,6 +269,36 @@ fn an_off_pose_after_stage_1_is_randomised_and_retried() {
     assert_eq!(outcome.randomisations, 1);
 }
 
+/// A layer turned during Stage 1 passes the pose check, is counted as Stage 1's, and is
+/// caught by the move check with rollback (a re-plan) but spoils the plan open loop.
+#[test]
+fn a_layer_turned_by_stage_1_is_counted_and_caught_only_with_rollback() {
+    for rollback in [true, false] {
+        let outcome = attempt(
+            &mut SkewingStage1 {
+                skews: 1,
+                angle: std::f64::consts::FRAC_PI_2,
+            },
+            &mut KinematicStage2 { angle: U_PRIME },
+            rollback,
+            4,
+            6,
+        );
+        assert_eq!(outcome.stages.stage1_turned, Some(1), "{outcome:?}");
+        assert_eq!(outcome.stages.stage1_reached, outcome.stages.stage1_runs);
+        assert_eq!(outcome.solved, rollback, "{outcome:?}");
+        assert_eq!(outcome.replans >= 1, rollback, "{outcome:?}");
+    }
+    let perfect = attempt(
+        &mut KinematicStage1,
+        &mut KinematicStage2 { angle: U_PRIME },
+        false,
+        4,
+        6,
+    );
+    assert_eq!(perfect.stages.stage1_turned, Some(0), "{perfect:?}");
+}
+
 /// A Stage 2 whose first run turns the top layer by `first`, and every later run by U'.
 struct WrongFirstTurn {
     first: Option<f64>,
@@ -582,10 +612,12 @@ fn steadying_holds_the_hand_still_once_per_stray() {
     );
 }
 
-/// A Stage 1 that reaches its pose but leaves the layer on the cube's right skewed by 0.3 rad
-/// on its first run.
+/// A Stage 1 that reaches its pose but, on its first `skews` runs, leaves the layer on the
+/// cube's right turned by `angle` (0.3 rad: skewed; a quarter turn: square, the puzzle
+/// changed).
 struct SkewingStage1 {
     skews: usize,
+    angle: f64,
 }
 
 impl Stage1 for SkewingStage1 {
@@ -593,7 +625,7 @@ impl Stage1 for SkewingStage1 {
         let run = KinematicStage1.run(sim, position, target, watch);
         if self.skews > 0 {
             self.skews -= 1;
-            dexcube_sim::cube::turn_face_by(sim, Face::R, 0.3);
+            dexcube_sim::cube::turn_face_by(sim, Face::R, self.angle);
             sim.forward();
         }
         run
@@ -612,7 +644,10 @@ fn a_skewed_cube_after_stage_1_is_restored_only_when_told() {
             ..OperatorConfig::default()
         };
         let stages = (
-            &mut SkewingStage1 { skews: 1 } as &mut dyn Stage1,
+            &mut SkewingStage1 {
+                skews: 1,
+                angle: 0.3,
+            } as &mut dyn Stage1,
             &mut KinematicStage2 { angle: U_PRIME } as &mut dyn Stage2,
         );
         let mut events = Vec::new();
