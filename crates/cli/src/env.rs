@@ -178,21 +178,26 @@ impl EnvChoice {
     /// good state as well, and with `--intact` no layer turned too.
     pub fn rot_goal(&self) -> anyhow::Result<RotGoal> {
         let paper = RotGoal::paper(self.mode);
-        Ok(match (self.square()?, self.intact()?) {
-            (_, true) => paper.left_intact(),
-            (true, false) => paper.left_square(),
-            (false, false) => paper,
+        Ok(if self.intact()? {
+            paper.left_intact()
+        } else if self.square()? {
+            paper.left_square()
+        } else {
+            paper
         })
     }
 
-    /// How the success test's name goes on after the stage's own part: ", left square", and
-    /// " and intact" with `--intact`.
-    pub fn success_suffix(&self) -> anyhow::Result<&'static str> {
-        Ok(match (self.square()?, self.intact()?) {
-            (_, true) => ", left square and intact",
-            (true, false) => ", left square",
-            (false, false) => "",
-        })
+    /// How the success test's name goes on after the stage's own part, `cube` naming the
+    /// object or not: ", left square" (", cube left square"), then " and intact" with
+    /// `--intact`.
+    pub fn success_suffix(&self, cube: &str) -> anyhow::Result<String> {
+        let square = if self.square()? {
+            format!(", {cube}left square")
+        } else {
+            String::new()
+        };
+        let intact = if self.intact()? { " and intact" } else { "" };
+        Ok(square + intact)
     }
 
     /// LayerOpEnv's success test: the paper's, or with `--square` the good state as well.
@@ -211,7 +216,7 @@ impl EnvChoice {
             EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
             EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
         };
-        let square = self.success_suffix()?;
+        let square = self.success_suffix("")?;
         let seen = self
             .view()?
             .name()
@@ -298,11 +303,17 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
         "  episode:     {} control steps of 20 x 0.002 s",
         dexcube_env::EPISODE_STEPS
     );
-    let square = match (choice.square()?, choice.intact()?) {
-        (_, true) => ", every cubelet within 0.1 rad of a quarter turn, no layer turned",
-        (true, false) => ", every cubelet within 0.1 rad of a quarter turn",
-        (false, false) => "",
+    let square = if choice.square()? {
+        ", every cubelet within 0.1 rad of a quarter turn"
+    } else {
+        ""
     };
+    let square = square.to_string()
+        + if choice.intact()? {
+            ", no layer turned"
+        } else {
+            ""
+        };
     match choice.env {
         EnvKind::Rot => println!(
             "  success:     position within 0.01 m and {} within 0.1 rad{square}; reward 0, else -1",

@@ -796,8 +796,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let endings: [AtomicUsize; 7] = Default::default();
     let held: [AtomicUsize; HOLDS.len()] = Default::default();
     let wins_out_of_square = AtomicUsize::new(0);
-    // Stage 1 episodes that kept the cube and ended with a layer turned: (all, successes).
-    let layer_turns = [AtomicUsize::new(0), AtomicUsize::new(0)];
+    // Stage 1 episodes that kept the cube and ended with a layer turned, and of them successes.
+    let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let rot_goal = RotGoal::paper(files.rot_mode);
     let thresholds = match args.stage {
         EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
@@ -898,9 +898,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
             }
             if !turning && ending != Ending::Dropped && trace.turned_a_layer {
-                layer_turns[0].fetch_add(1, Ordering::Relaxed);
+                layer_turns.fetch_add(1, Ordering::Relaxed);
                 if ending == Ending::Success {
-                    layer_turns[1].fetch_add(1, Ordering::Relaxed);
+                    successes_with_layer_turns.fetch_add(1, Ordering::Relaxed);
                 }
             }
             for (count, steps) in held.iter().zip(HOLDS) {
@@ -952,9 +952,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if args.stage == EnvKind::Rot && object == ObjectKind::Cube {
-        let [turned, of_them_successes] = layer_turns.map(AtomicUsize::into_inner);
         println!(
-            "  kept the cube but ended with a layer turned from where it began: {turned} ({of_them_successes} of them successes)"
+            "  kept the cube but ended with a layer turned from where it began: {} ({} of them successes)",
+            layer_turns.into_inner(),
+            successes_with_layer_turns.into_inner()
         );
     }
     for (count, steps) in held.iter().zip(HOLDS) {

@@ -352,7 +352,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     EnvKind::Rot => "pose",
                     EnvKind::Layer => "angle",
                 },
-                args.choice.success_suffix()?.replace(", left", ", cube left")
+                args.choice.success_suffix("cube ")?
             ),
             "observation": view.name().map_or("paper".to_string(), |name| format!("with the {name}")),
             "object": object.name(),

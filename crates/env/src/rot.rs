@@ -28,7 +28,7 @@
 use std::sync::Arc;
 
 use dexcube_cube::Facelets;
-use dexcube_sim::cube::{CubeState, read_puzzle, turned_since};
+use dexcube_sim::cube::{CubeState, read_puzzle};
 use dexcube_sim::rotation::Quat;
 use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
@@ -174,7 +174,7 @@ impl CubeRotEnv {
 /// The observations, with the cube's pose (observations 48 to 54) as the achieved goal, and
 /// with a goal that needs the good state, the cube's misalignment after it, a quarter turn
 /// more once a layer has turned from `puzzle_at_start` if the goal needs the cube intact.
-/// The misalignment is read once, and only if the goal or the view needs it.
+/// The cube is read once a step, and only if the goal or the view needs it.
 fn observe(
     hand: &HandObject,
     goal: &RotGoal,
@@ -182,16 +182,22 @@ fn observe(
     view: View,
     puzzle_at_start: Option<&Facelets>,
 ) -> Observation {
-    let misalignment = (goal.square_threshold.is_some() || view.misalignment)
-        .then(|| cube_misalignment(&hand.sim));
+    let read = goal.square_threshold.is_some() || view.misalignment;
+    let cube = read.then(|| CubeState::read(&hand.sim)).flatten();
+    // The rigid cube is always square.
+    let misalignment = read.then(|| cube.as_ref().map_or(0.0, CubeState::misalignment));
     let observation = rot_observation(&hand.sim, view, misalignment);
-    let turned = goal.intact && turned_since(puzzle_at_start, &hand.sim);
-    let achieved_misalignment = misalignment.unwrap_or(0.0)
-        + if turned {
-            std::f64::consts::FRAC_PI_2
-        } else {
-            0.0
-        };
+    let turned = goal.intact
+        && cube
+            .as_ref()
+            .zip(puzzle_at_start)
+            .is_some_and(|(cube, start)| cube.turned_since(start));
+    let quarter_if_turned = if turned {
+        std::f64::consts::FRAC_PI_2
+    } else {
+        0.0
+    };
+    let achieved_misalignment = misalignment.unwrap_or(0.0) + quarter_if_turned;
     Observation {
         achieved_goal: goal.achieved(&observation[48..55], achieved_misalignment),
         desired_goal: goal.desired(desired),

@@ -162,6 +162,12 @@ impl CubeState {
         self.facelets_seen_from(&IDENTITY)
     }
 
+    /// Whether this cube has a layer turned from the puzzle `start` (its stickers in its own
+    /// frame, as [`read_puzzle`] gives them); false if they cannot be read.
+    pub fn turned_since(&self, start: &Facelets) -> bool {
+        self.facelets_in_cube_frame().is_ok_and(|now| now != *start)
+    }
+
     /// The 24 stickers by the world direction they face (U up, R towards +x, B towards +y),
     /// with the cube's orientation snapped to the nearest axis-aligned one.
     pub fn facelets_in_world(&self) -> Result<Facelets, FaceletError> {
@@ -199,7 +205,7 @@ pub fn read_puzzle(sim: &Sim) -> Option<Facelets> {
 /// Whether the cube in `sim` has a layer turned from the puzzle `start` (false if either
 /// cannot be read): what a re-posing of the whole cube, Stage 1, must never do.
 pub fn turned_since(start: Option<&Facelets>, sim: &Sim) -> bool {
-    start.is_some_and(|start| read_puzzle(sim).is_some_and(|now| now != *start))
+    start.is_some_and(|start| CubeState::read(sim).is_some_and(|cube| cube.turned_since(start)))
 }
 
 /// Turns one face of the cube in the physics by setting joint positions, as a perfect hand
