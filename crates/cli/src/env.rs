@@ -303,17 +303,11 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
         "  episode:     {} control steps of 20 x 0.002 s",
         dexcube_env::EPISODE_STEPS
     );
-    let square = if choice.square()? {
-        ", every cubelet within 0.1 rad of a quarter turn"
-    } else {
-        ""
+    let square = match (choice.square()?, choice.intact()?) {
+        (_, true) => ", every cubelet within 0.1 rad of a quarter turn, no layer turned",
+        (true, false) => ", every cubelet within 0.1 rad of a quarter turn",
+        (false, false) => "",
     };
-    let square = square.to_string()
-        + if choice.intact()? {
-            ", no layer turned"
-        } else {
-            ""
-        };
     match choice.env {
         EnvKind::Rot => println!(
             "  success:     position within 0.01 m and {} within 0.1 rad{square}; reward 0, else -1",
