@@ -105,6 +105,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
                 format!("  Stage 2: U' on the top layer ({turn} of {of})")
             }
             Event::Randomised(why) => format!("  rollback: {why}"),
+            Event::Stage1TurnedLayer => {
+                "  rollback: Stage 1 turned a layer; Stage 2 skipped".to_string()
+            }
             Event::Ended { stage, failure } => format!(
                 "  Stage {stage} ended the attempt: {}",
                 match failure {

@@ -62,6 +62,11 @@ pub struct OperatorArgs {
     /// that of equally short plans one starting on that face (no Stage 1) is preferred.
     #[arg(long, conflicts_with = "paper_operator")]
     pub plan_from_face_up: bool,
+    /// With rollback, read the puzzle after Stage 1 too: if a layer turned while the cube was
+    /// re-posed, skip the move's Stage 2 and re-plan from what is there (by default the
+    /// operator turns first and finds the move did not happen after).
+    #[arg(long)]
+    pub stage1_puzzle_check: bool,
     /// Planning for the hand, take the cheapest plan of any length rather than of the optimal
     /// ones, with each U' turn priced 1 and each Stage 1 this many: a Stage 1 risks the cube
     /// more than a turn (in Table I, 1.4% of Stage 1 runs dropped it, 0.03% of Stage 2 runs).
@@ -146,6 +151,7 @@ impl OperatorArgs {
             already_up: self.already_up.rule(),
             stage1_good_state: self.stage1_good_state,
             plan_from_face_up: self.plan_from_face_up,
+            stage1_puzzle_check: self.stage1_puzzle_check,
             ..OperatorConfig::default()
         }
     }
@@ -155,7 +161,11 @@ impl OperatorArgs {
     fn name(self) -> String {
         let config = self.config(true);
         let driving = config.driving;
-        if self.paper_operator && driving == Driving::default() && !config.stage1_good_state {
+        if self.paper_operator
+            && driving == Driving::default()
+            && !config.stage1_good_state
+            && !config.stage1_puzzle_check
+        {
             return "paper".to_string();
         }
         let planner = if self.paper_operator {
@@ -185,6 +195,10 @@ impl OperatorArgs {
             config.plan_from_face_up,
             ", the first move priced knowing the face up",
         );
+        let puzzle_check = when(
+            config.stage1_puzzle_check,
+            ", the puzzle checked after Stage 1",
+        );
         let any_length = self.stage1_price.map_or(String::new(), |price| {
             format!(", plans of any length with a Stage 1 priced {price} turns")
         });
@@ -195,7 +209,7 @@ impl OperatorArgs {
             )
         });
         format!(
-            "{planner}{any_length}, opening the hand {opening}, {stage1}{steadying}{skip}{square}{first_move}"
+            "{planner}{any_length}, opening the hand {opening}, {stage1}{steadying}{skip}{square}{puzzle_check}{first_move}"
         )
     }
 
@@ -224,6 +238,7 @@ impl OperatorArgs {
         };
         let square = when(self.stage1_good_state, " --stage1-good-state");
         let first_move = when(self.plan_from_face_up, " --plan-from-face-up");
+        let puzzle_check = when(self.stage1_puzzle_check, " --stage1-puzzle-check");
         let price = self
             .stage1_price
             .map_or(String::new(), |price| format!(" --stage1-price {price}"));
@@ -233,7 +248,9 @@ impl OperatorArgs {
                 self.steady_steps
             )
         });
-        format!("{paper}{held}{opening}{already_up}{square}{first_move}{price}{steady}")
+        format!(
+            "{paper}{held}{opening}{already_up}{square}{puzzle_check}{first_move}{price}{steady}"
+        )
     }
 }
 

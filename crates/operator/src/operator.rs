@@ -10,7 +10,10 @@
 //!    "randomisation"); the move's remaining turns are then skipped, since another face may
 //!    now be up, and the check below re-plans.
 //! 3. With rollback, the facelets read from the physics are compared with the expected ones;
-//!    if the move did not happen, the operator re-plans from what it sees.
+//!    if the move did not happen, the operator re-plans from what it sees. Told to
+//!    (`OperatorConfig::stage1_puzzle_check`), it also reads the puzzle after Stage 1 and, if
+//!    a layer turned while the cube was re-posed, skips the move's Stage 2 and goes straight
+//!    to that check.
 //!
 //! Without rollback the plan runs open loop. Action number (AN) counts atomic actions, Stage 1
 //! and Stage 2 runs alike; randomisations are counted apart.
@@ -147,6 +150,9 @@ pub enum Event {
     Randomised(&'static str),
     MoveDone(Move),
     Replan(Vec<Move>),
+    /// With rollback and the puzzle checked after Stage 1: Stage 1 left a layer turned, so
+    /// the move's Stage 2 is skipped and the move check re-plans.
+    Stage1TurnedLayer,
     /// A stage ended the attempt: the cube fell, or the physics blew up.
     Ended {
         stage: usize,
@@ -177,6 +183,10 @@ pub struct OperatorConfig {
     /// Planning for the hand, price each plan's first move knowing which face is up now (by
     /// the test that skips Stage 1), rather than as if a Stage 1 were always needed first.
     pub plan_from_face_up: bool,
+    /// With rollback, read the puzzle after Stage 1 too: if a layer turned while the cube was
+    /// re-posed, the plan no longer fits, so the move's Stage 2 is skipped and the operator
+    /// re-plans from what it sees, rather than turning first and finding out after.
+    pub stage1_puzzle_check: bool,
 }
 
 impl Default for OperatorConfig {
@@ -191,6 +201,7 @@ impl Default for OperatorConfig {
             already_up: AlreadyUp::Pose,
             stage1_good_state: false,
             plan_from_face_up: false,
+            stage1_puzzle_check: false,
         }
     }
 }
@@ -378,6 +389,12 @@ impl Operator<'_> {
             narrate(&Event::AlreadyUp(up));
             stage1_attempts = 0;
         }
+        let check_puzzle = self.config.rollback && self.config.stage1_puzzle_check;
+        let puzzle_at_move = if check_puzzle && stage1_attempts > 0 {
+            read_puzzle(sim)
+        } else {
+            None
+        };
         for attempt in 1..=stage1_attempts {
             let puzzle_before = read_puzzle(sim);
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
@@ -412,6 +429,10 @@ impl Operator<'_> {
             } else {
                 "not in a good state: layers restored, random pose, then Stage 1 again"
             }));
+        }
+        if turned_since(puzzle_at_move.as_ref(), sim) {
+            narrate(&Event::Stage1TurnedLayer);
+            return None;
         }
         for turn in 1..=turns {
             let run = self.stage2.run(sim, &mut *self.watch);

@@ -299,6 +299,49 @@ fn a_layer_turned_by_stage_1_is_counted_and_caught_only_with_rollback() {
     assert_eq!(perfect.stages.stage1_turned, Some(0), "{perfect:?}");
 }
 
+/// Told to check the puzzle after Stage 1, the rollback skips the Stage 2 of a move whose
+/// Stage 1 turned a layer and re-plans at once: the cube is solved with fewer Stage 2 runs
+/// than when the operator turns first and finds out after.
+#[test]
+fn a_layer_turned_by_stage_1_skips_stage_2_when_the_puzzle_is_checked() {
+    let table = DistanceTable::build();
+    let scramble = scrambles_at_distance(&table, 4, 1, 6).remove(0);
+    let outcomes = [false, true].map(|stage1_puzzle_check| {
+        let config = OperatorConfig {
+            stage1_puzzle_check,
+            ..OperatorConfig::default()
+        };
+        let mut events = Vec::new();
+        let outcome = solve_from(
+            &scramble.moves,
+            level_at(RESTING),
+            (RotMode::Pair, config, None),
+            (
+                &mut SkewingStage1 {
+                    skews: 1,
+                    angle: std::f64::consts::FRAC_PI_2,
+                },
+                &mut KinematicStage2 { angle: U_PRIME },
+            ),
+            6,
+            &mut |e| events.push(e.clone()),
+        );
+        let skipped = events
+            .iter()
+            .any(|e| matches!(e, dexcube_operator::Event::Stage1TurnedLayer));
+        assert_eq!(skipped, stage1_puzzle_check, "{events:?}");
+        assert!(outcome.solved, "{outcome:?}");
+        assert_eq!(outcome.stages.stage1_turned, Some(1), "{outcome:?}");
+        assert!(outcome.replans >= 1, "{outcome:?}");
+        outcome
+    });
+    let [turned_first, checked] = outcomes;
+    assert!(
+        checked.stages.stage2_runs < turned_first.stages.stage2_runs,
+        "{checked:?} against {turned_first:?}"
+    );
+}
+
 /// A Stage 2 whose first run turns the top layer by `first`, and every later run by U'.
 struct WrongFirstTurn {
     first: Option<f64>,
