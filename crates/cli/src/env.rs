@@ -90,6 +90,11 @@ pub struct EnvChoice {
     /// leaves the cube square, but changes the puzzle). Implies --square.
     #[arg(long)]
     pub intact: bool,
+    /// With --intact: a turned layer also ends the episode as a failure that lasts (absorbing),
+    /// as a drop does, rather than leaving the steps after it, which do not show the turn, to
+    /// fail one by one.
+    #[arg(long, requires = "intact")]
+    pub turn_ends: bool,
     /// On the physical cube only: the observation gains the cube's misalignment (the largest
     /// angle of a cubelet off a quarter turn, in tenths of a radian), which the good state's
     /// test reads and the paper's observations (61 for CubeRotEnv, 62 for LayerOpEnv) do not
@@ -178,7 +183,9 @@ impl EnvChoice {
     /// good state as well, and with `--intact` no layer turned too.
     pub fn rot_goal(&self) -> anyhow::Result<RotGoal> {
         let paper = RotGoal::paper(self.mode);
-        Ok(if self.intact()? {
+        Ok(if self.intact()? && self.turn_ends {
+            paper.ending_on_turn()
+        } else if self.intact()? {
             paper.left_intact()
         } else if self.square()? {
             paper.left_square()
@@ -189,14 +196,18 @@ impl EnvChoice {
 
     /// How the success test's name goes on after the stage's own part, `cube` naming the
     /// object or not: ", left square" (", cube left square"), then " and intact" with
-    /// `--intact`.
+    /// `--intact`, and how a turn ends the episode with `--turn-ends`.
     pub fn success_suffix(&self, cube: &str) -> anyhow::Result<String> {
         let square = if self.square()? {
             format!(", {cube}left square")
         } else {
             String::new()
         };
-        let intact = if self.intact()? { " and intact" } else { "" };
+        let intact = match (self.intact()?, self.turn_ends) {
+            (true, true) => " and intact, a turn ending the episode",
+            (true, false) => " and intact",
+            (false, _) => "",
+        };
         Ok(square + intact)
     }
 

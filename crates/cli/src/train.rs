@@ -275,6 +275,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         }
     } + if square { "-square" } else { "" }
         + if args.choice.intact()? { "-intact" } else { "" }
+        + if args.choice.turn_ends { "-ends" } else { "" }
         + if view.misalignment { "-seen" } else { "" }
         + if view.grip { "-grip" } else { "" };
     let name = args.choice.env.name();

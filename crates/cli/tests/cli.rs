@@ -531,6 +531,7 @@ fn train_refuses_settings_it_cannot_run() {
         ),
         (&["rot", "--failed-weight", "5"], "--starts <FILE>"),
         (&["rot", "--intact"], "--intact is for the physical cube"),
+        (&["rot", "--object", "cube", "--turn-ends"], "--intact"),
         (
             &["layer", "--object", "cube", "--intact"],
             "--intact is for CubeRotEnv",

@@ -63,6 +63,10 @@ pub struct RotGoal {
     /// policy cannot tell from its goal's size whether it was trained so (its actor never
     /// sees the achieved goal).
     pub intact: bool,
+    /// With `intact`, a turned layer also ends the episode as an absorbing failure, as a drop
+    /// does: once a layer has gone a whole quarter round the cube is square again and the
+    /// observations do not show the turn, so the steps after it would look like any others.
+    pub turn_ends: bool,
 }
 
 /// Length of a pose goal: position 3, quaternion 4.
@@ -77,6 +81,7 @@ impl RotGoal {
             angle_threshold: 0.1,
             square_threshold: None,
             intact: false,
+            turn_ends: false,
         }
     }
 
@@ -93,6 +98,14 @@ impl RotGoal {
         RotGoal {
             intact: true,
             ..self.left_square()
+        }
+    }
+
+    /// The same test as [`RotGoal::left_intact`], and a turned layer ends the episode.
+    pub fn ending_on_turn(self) -> RotGoal {
+        RotGoal {
+            turn_ends: true,
+            ..self.left_intact()
         }
     }
 

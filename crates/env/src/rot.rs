@@ -9,7 +9,8 @@
 //! and a pose reached with a layer pushed part-way round must be restored before Stage 2.
 //! With [`RotGoal::left_intact`] it also needs no layer turned from where it began: a layer
 //! pushed a whole quarter round leaves the cube square but changes the puzzle, which spoils
-//! the rest of the operator's plan.
+//! the rest of the operator's plan. With [`RotGoal::ending_on_turn`] such a turn also ends
+//! the episode as an absorbing failure, as a drop does.
 //! On the physical cube the policy may also be shown more ([`CubeRotEnv::with_view`]): that
 //! misalignment (62), in units of the good state's tolerance, as LayerOpEnv's view can be, the
 //! part of the achieved goal that the 61 do not show; and the hand's grip on the cube (six
@@ -114,7 +115,7 @@ impl CubeRotEnv {
             .intact
             .then(|| read_puzzle(&self.hand.sim))
             .flatten();
-        let observation = observe(
+        let (observation, _) = observe(
             &self.hand,
             &self.goal,
             &self.desired,
@@ -174,14 +175,15 @@ impl CubeRotEnv {
 /// The observations, with the cube's pose (observations 48 to 54) as the achieved goal, and
 /// with a goal that needs the good state, the cube's misalignment after it, a quarter turn
 /// more once a layer has turned from `puzzle_at_start` if the goal needs the cube intact.
-/// The cube is read once a step, and only if the goal or the view needs it.
+/// The cube is read once a step, and only if the goal or the view needs it. Also says
+/// whether a layer has turned (always false unless the goal needs the cube intact).
 fn observe(
     hand: &HandObject,
     goal: &RotGoal,
     desired: &[f64],
     view: View,
     puzzle_at_start: Option<&Facelets>,
-) -> Observation {
+) -> (Observation, bool) {
     let read = goal.square_threshold.is_some() || view.misalignment;
     let cube = read.then(|| CubeState::read(&hand.sim)).flatten();
     // The rigid cube is always square.
@@ -198,11 +200,12 @@ fn observe(
         0.0
     };
     let achieved_misalignment = misalignment.unwrap_or(0.0) + quarter_if_turned;
-    Observation {
+    let observation = Observation {
         achieved_goal: goal.achieved(&observation[48..55], achieved_misalignment),
         desired_goal: goal.desired(desired),
         observation,
-    }
+    };
+    (observation, turned)
 }
 
 /// Stage 1's observations of the object in `sim`: the 61, then what `view` shows beyond them,
@@ -292,9 +295,14 @@ impl GoalEnv for CubeRotEnv {
     fn step(&mut self, action: &[f64]) -> Transition {
         let (goal, desired, view) = (&self.goal, &self.desired, self.view);
         let start = self.puzzle_at_start.as_ref();
-        self.hand.step(action, goal.as_ref(), |hand| {
-            observe(hand, goal, desired, view, start)
-        })
+        let mut turned = false;
+        let mut transition = self.hand.step(action, goal.as_ref(), |hand| {
+            let (observation, turned_now) = observe(hand, goal, desired, view, start);
+            turned = turned_now;
+            observation
+        });
+        transition.terminated |= goal.turn_ends && turned;
+        transition
     }
 }
 

@@ -609,6 +609,29 @@ fn a_pose_reached_intact_needs_no_layer_turned() {
     );
 }
 
+/// Asked to, CubeRotEnv ends the episode when a layer turns, as it does at a drop: the
+/// intact goal alone goes on, and neither ends a step with no layer turned.
+#[test]
+fn a_turned_layer_ends_the_episode_only_when_asked() {
+    let scene = Scene::load(ObjectKind::Cube.scene()).unwrap();
+    for (goal, ends) in [
+        (RotGoal::paper(RotMode::Pair).left_intact(), false),
+        (RotGoal::paper(RotMode::Pair).ending_on_turn(), true),
+    ] {
+        let mut env = CubeRotEnv::with_scene(scene.clone(), goal);
+        env.reset(Some(5));
+        let still = env.step(&[0.0; 20]);
+        assert!(!still.terminated, "no layer turned yet");
+        let side = face_toward(&env.sim().object_pose().orientation, [1.0, 0.0, 0.0]);
+        turn_face_by(env.sim_mut(), side, FRAC_PI_2);
+        env.sim_mut().forward();
+        let turned = env.step(&[0.0; 20]);
+        assert!(!turned.info.dropped, "the cube is still on the palm");
+        assert_eq!(turned.terminated, ends, "{goal:?}");
+        assert_eq!(turned.reward, -1.0);
+    }
+}
+
 /// About one landing in ten on the flat hand knocks a layer of the physical cube out of its
 /// good state; such a start is set down again, so every episode starts with a turnable cube.
 #[test]

@@ -432,7 +432,9 @@ impl Operator<'_> {
         }
         if turned_since(puzzle_at_move.as_ref(), sim) {
             narrate(&Event::Stage1TurnedLayer);
-            return None;
+            // A layer Stage 1 dragged round may have stopped short of a quarter turn: the
+            // cube is put back in its good state before the move check reads it.
+            return self.restore_good_state(sim, outcome, narrate).err();
         }
         for turn in 1..=turns {
             let run = self.stage2.run(sim, &mut *self.watch);
@@ -445,27 +447,41 @@ impl Operator<'_> {
             outcome.stages.stage2_runs += 1;
             outcome.stages.stage2_misaligned += usize::from(!is_square(sim));
             if self.config.rollback {
-                let mut restores = 0;
-                while !is_square(sim) {
-                    if restores == self.config.restores {
-                        return Some(Failure::StuckMisaligned);
-                    }
-                    snap_layers(sim);
-                    randomise_pose(sim, self.resting, &mut self.rng);
-                    restores += 1;
-                    outcome.randomisations += 1;
-                    narrate(&Event::Randomised(
-                        "not in a good state: layers restored, random pose",
-                    ));
-                }
                 // A restored cube lies in a random pose: the rest of this move's turns
                 // would turn whatever face is up. The move check re-plans from here.
-                if restores > 0 {
-                    break;
+                match self.restore_good_state(sim, outcome, narrate) {
+                    Ok(0) => {}
+                    Ok(_) => break,
+                    Err(failure) => return Some(failure),
                 }
             }
         }
         None
+    }
+
+    /// The rollback's restore: while the cube is out of its good state, its layers are worked
+    /// back to the nearest quarter turn and it is re-seated at a random pose, at most
+    /// `OperatorConfig::restores` times. Returns how many restores it took.
+    fn restore_good_state(
+        &mut self,
+        sim: &mut Sim,
+        outcome: &mut Outcome,
+        narrate: &mut dyn FnMut(&Event),
+    ) -> Result<usize, Failure> {
+        let mut restores = 0;
+        while !is_square(sim) {
+            if restores == self.config.restores {
+                return Err(Failure::StuckMisaligned);
+            }
+            snap_layers(sim);
+            randomise_pose(sim, self.resting, &mut self.rng);
+            restores += 1;
+            outcome.randomisations += 1;
+            narrate(&Event::Randomised(
+                "not in a good state: layers restored, random pose",
+            ));
+        }
+        Ok(restores)
     }
 }
 

@@ -301,9 +301,16 @@ fn a_layer_turned_by_stage_1_is_counted_and_caught_only_with_rollback() {
 
 /// Told to check the puzzle after Stage 1, the rollback skips the Stage 2 of a move whose
 /// Stage 1 turned a layer and re-plans at once: the cube is solved with fewer Stage 2 runs
-/// than when the operator turns first and finds out after.
+/// than when the operator turns first and finds out after, whether the layer went a whole
+/// quarter turn or stopped short of one (then the cube is restored to its good state first).
 #[test]
 fn a_layer_turned_by_stage_1_skips_stage_2_when_the_puzzle_is_checked() {
+    for angle in [std::f64::consts::FRAC_PI_2, 1.2] {
+        layer_turned_by_stage_1_with_the_puzzle_checked_or_not(angle);
+    }
+}
+
+fn layer_turned_by_stage_1_with_the_puzzle_checked_or_not(angle: f64) {
     let table = DistanceTable::build();
     let scramble = scrambles_at_distance(&table, 4, 1, 6).remove(0);
     let outcomes = [false, true].map(|stage1_puzzle_check| {
@@ -317,20 +324,25 @@ fn a_layer_turned_by_stage_1_skips_stage_2_when_the_puzzle_is_checked() {
             level_at(RESTING),
             (RotMode::Pair, config, None),
             (
-                &mut SkewingStage1 {
-                    skews: 1,
-                    angle: std::f64::consts::FRAC_PI_2,
-                },
+                &mut SkewingStage1 { skews: 1, angle },
                 &mut KinematicStage2 { angle: U_PRIME },
             ),
             6,
             &mut |e| events.push(e.clone()),
         );
-        let skipped = events
+        let skipped_at = events
             .iter()
-            .any(|e| matches!(e, dexcube_operator::Event::Stage1TurnedLayer));
-        assert_eq!(skipped, stage1_puzzle_check, "{events:?}");
-        assert!(outcome.solved, "{outcome:?}");
+            .position(|e| matches!(e, dexcube_operator::Event::Stage1TurnedLayer));
+        assert_eq!(skipped_at.is_some(), stage1_puzzle_check, "{events:?}");
+        if let Some(at) = skipped_at {
+            let restored = matches!(
+                events.get(at + 1),
+                Some(dexcube_operator::Event::Randomised(_))
+            );
+            let short_of_a_quarter = angle != std::f64::consts::FRAC_PI_2;
+            assert_eq!(restored, short_of_a_quarter, "{angle}: {events:?}");
+        }
+        assert!(outcome.solved, "{angle}: {outcome:?}");
         assert_eq!(outcome.stages.stage1_turned, Some(1), "{outcome:?}");
         assert!(outcome.replans >= 1, "{outcome:?}");
         outcome
