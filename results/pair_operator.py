@@ -7,7 +7,8 @@ Standard library only. A cube is its move distance, its index within that distan
 a run of 20 cubes per distance pairs with the first 20 of a run of 100 at the same seed. Only cubes in both
 files are compared. For each half and for both together it prints the cubes solved by each, the cubes solved
 by only one and the two-sided sign test on those, the mean action number over all the paired cubes (as
-Table I counts it), each stage's runs, the Stage 2 runs that left the cube out of its good state, and the
+Table I counts it) and, over the cubes both solved, how many took fewer actions in each with the sign test
+on those, each stage's runs, the Stage 2 runs that left the cube out of its good state, and the
 cubes lost to a drop in each stage.
 """
 import csv, os, sys
@@ -38,6 +39,11 @@ def compare(label, keys, first, second):
     only_a, only_b = discordant(a, b)
     print(f"{label}: cubes {len(keys)}; solved: first {sum(a)}, second {sum(b)}; "
           f"only first {only_a}, only second {only_b}; sign test p = {sign_test(only_a, only_b):.3g}")
+    both = [k for k, x, y in zip(keys, a, b) if x and y]
+    fewer_a = sum(int(first[k]['actions']) < int(second[k]['actions']) for k in both)
+    fewer_b = sum(int(second[k]['actions']) < int(first[k]['actions']) for k in both)
+    print(f"  of the {len(both)} both solved, fewer actions: first {fewer_a}, second {fewer_b}; "
+          f"sign test p = {sign_test(fewer_a, fewer_b):.3g}")
     print(f"  first:  {summary([first[k] for k in keys])}")
     print(f"  second: {summary([second[k] for k in keys])}")
 

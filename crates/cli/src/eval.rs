@@ -63,10 +63,15 @@ pub struct OperatorArgs {
     #[arg(long, conflicts_with = "paper_operator")]
     pub plan_from_face_up: bool,
     /// With rollback, read the puzzle after Stage 1 too: if a layer turned while the cube was
-    /// re-posed, skip the move's Stage 2 and re-plan from what is there (by default the
-    /// operator turns first and finds the move did not happen after).
-    #[arg(long)]
+    /// re-posed, skip the move's Stage 2 and re-plan from what is there. The default planning
+    /// for the hand (measured in Table I, session 32: as many cubes, fewer actions); off with
+    /// --paper-operator.
+    #[arg(long, overrides_with = "no_stage1_puzzle_check")]
     pub stage1_puzzle_check: bool,
+    /// Without the check after Stage 1: the operator turns first and finds out after, from
+    /// the move check, that the move did not happen (the default until session 32).
+    #[arg(long, overrides_with = "stage1_puzzle_check")]
+    pub no_stage1_puzzle_check: bool,
     /// Planning for the hand, take the cheapest plan of any length rather than of the optimal
     /// ones, with each U' turn priced 1 and each Stage 1 this many: a Stage 1 risks the cube
     /// more than a turn (in Table I, 1.4% of Stage 1 runs dropped it, 0.03% of Stage 2 runs).
@@ -151,7 +156,7 @@ impl OperatorArgs {
             already_up: self.already_up.rule(),
             stage1_good_state: self.stage1_good_state,
             plan_from_face_up: self.plan_from_face_up,
-            stage1_puzzle_check: self.stage1_puzzle_check,
+            stage1_puzzle_check: self.puzzle_check(),
             ..OperatorConfig::default()
         }
     }
@@ -213,6 +218,16 @@ impl OperatorArgs {
         )
     }
 
+    /// Whether the rollback reads the puzzle after Stage 1: as asked, else planning for the
+    /// hand and not with the paper's operator.
+    fn puzzle_check(self) -> bool {
+        match (self.stage1_puzzle_check, self.no_stage1_puzzle_check) {
+            (true, _) => true,
+            (false, true) => false,
+            (false, false) => !self.paper_operator,
+        }
+    }
+
     /// The cost table for plans of any length, when a Stage 1 price asks for them (a couple of
     /// seconds to build).
     pub fn hand_plans(self) -> Option<CostTable> {
@@ -238,7 +253,11 @@ impl OperatorArgs {
         };
         let square = when(self.stage1_good_state, " --stage1-good-state");
         let first_move = when(self.plan_from_face_up, " --plan-from-face-up");
-        let puzzle_check = when(self.stage1_puzzle_check, " --stage1-puzzle-check");
+        let puzzle_check = match (self.puzzle_check(), self.paper_operator) {
+            (true, true) => " --stage1-puzzle-check",
+            (false, false) => " --no-stage1-puzzle-check",
+            _ => "",
+        };
         let price = self
             .stage1_price
             .map_or(String::new(), |price| format!(" --stage1-price {price}"));

@@ -10,10 +10,10 @@
 //!    "randomisation"); the move's remaining turns are then skipped, since another face may
 //!    now be up, and the check below re-plans.
 //! 3. With rollback, the facelets read from the physics are compared with the expected ones;
-//!    if the move did not happen, the operator re-plans from what it sees. Told to
-//!    (`OperatorConfig::stage1_puzzle_check`), it also reads the puzzle after Stage 1 and, if
-//!    a layer turned while the cube was re-posed, skips the move's Stage 2 and goes straight
-//!    to that check.
+//!    if the move did not happen, the operator re-plans from what it sees. By default
+//!    (`OperatorConfig::stage1_puzzle_check`) it also reads the puzzle after Stage 1 and, if
+//!    a layer turned while the cube was re-posed, restores the good state if need be, skips
+//!    the move's Stage 2 and goes straight to that check.
 //!
 //! Without rollback the plan runs open loop. Action number (AN) counts atomic actions, Stage 1
 //! and Stage 2 runs alike; randomisations are counted apart.
@@ -185,7 +185,9 @@ pub struct OperatorConfig {
     pub plan_from_face_up: bool,
     /// With rollback, read the puzzle after Stage 1 too: if a layer turned while the cube was
     /// re-posed, the plan no longer fits, so the move's Stage 2 is skipped and the operator
-    /// re-plans from what it sees, rather than turning first and finding out after.
+    /// re-plans from what it sees, rather than turning first and finding out after. On by
+    /// default since session 32 (Table I: 1,339 cubes against 1,332, fewer actions for 250
+    /// of the cubes both solved against 21); the paper's operator has no such check.
     pub stage1_puzzle_check: bool,
 }
 
@@ -201,7 +203,7 @@ impl Default for OperatorConfig {
             already_up: AlreadyUp::Pose,
             stage1_good_state: false,
             plan_from_face_up: false,
-            stage1_puzzle_check: false,
+            stage1_puzzle_check: true,
         }
     }
 }
