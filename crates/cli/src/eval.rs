@@ -1141,4 +1141,43 @@ mod tests {
         assert_eq!(mode(serde_json::json!({})), Some(RotMode::Paper));
         assert_eq!(mode(serde_json::json!({ "variant": "twirl" })), None);
     }
+
+    /// The check after Stage 1 is on planning for the hand and off for the paper's operator,
+    /// each unless told otherwise, and a run's record and command say which.
+    #[test]
+    fn the_puzzle_check_after_stage_1_is_the_hands_default_only() {
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            operator: OperatorArgs,
+        }
+        let operator = |flags: &[&str]| {
+            let args = std::iter::once("eval").chain(flags.iter().copied());
+            <Cli as clap::Parser>::parse_from(args).operator
+        };
+        for (flags, checked) in [
+            (&[][..], true),
+            (&["--no-stage1-puzzle-check"], false),
+            (&["--paper-operator"], false),
+            (&["--paper-operator", "--stage1-puzzle-check"], true),
+            (
+                &["--stage1-puzzle-check", "--no-stage1-puzzle-check"],
+                false,
+            ),
+        ] {
+            let args = operator(flags);
+            assert_eq!(args.config(true).stage1_puzzle_check, checked, "{flags:?}");
+            let named = args.name().contains("the puzzle checked after Stage 1");
+            assert_eq!(named, checked, "{flags:?}: {}", args.name());
+            assert_eq!(
+                operator(&args.flags().split_whitespace().collect::<Vec<_>>())
+                    .config(true)
+                    .stage1_puzzle_check,
+                checked,
+                "{flags:?}: {}",
+                args.flags()
+            );
+        }
+        assert_eq!(operator(&["--paper-operator"]).name(), "paper");
+    }
 }

@@ -151,7 +151,8 @@ pub enum Event {
     MoveDone(Move),
     Replan(Vec<Move>),
     /// With rollback and the puzzle checked after Stage 1: Stage 1 left a layer turned, so
-    /// the move's Stage 2 is skipped and the move check re-plans.
+    /// the move's Stage 2 is skipped, the cube restored to its good state if the layer
+    /// stopped short, and the move check re-plans.
     Stage1TurnedLayer,
     /// A stage ended the attempt: the cube fell, or the physics blew up.
     Ended {
