@@ -180,17 +180,15 @@ impl EnvChoice {
     }
 
     /// CubeRotEnv's success test: the paper's in the chosen mode, or with `--square` the
-    /// good state as well, and with `--intact` no layer turned too.
+    /// good state as well, with `--intact` no layer turned too, and with `--turn-ends` the
+    /// episode ended at a turn.
     pub fn rot_goal(&self) -> anyhow::Result<RotGoal> {
         let paper = RotGoal::paper(self.mode);
-        Ok(if self.intact()? && self.turn_ends {
-            paper.ending_on_turn()
-        } else if self.intact()? {
-            paper.left_intact()
-        } else if self.square()? {
-            paper.left_square()
-        } else {
-            paper
+        Ok(match (self.square()?, self.intact()?, self.turn_ends) {
+            (_, true, true) => paper.ending_on_turn(),
+            (_, true, false) => paper.left_intact(),
+            (true, false, _) => paper.left_square(),
+            (false, false, _) => paper,
         })
     }
 

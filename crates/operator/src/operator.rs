@@ -392,12 +392,11 @@ impl Operator<'_> {
             narrate(&Event::AlreadyUp(up));
             stage1_attempts = 0;
         }
-        let check_puzzle = self.config.rollback && self.config.stage1_puzzle_check;
-        let puzzle_at_move = if check_puzzle && stage1_attempts > 0 {
-            read_puzzle(sim)
-        } else {
-            None
-        };
+        // With the check, the puzzle as the move began: a layer turned by any of its Stage 1
+        // runs (a run's own count misses one whose start or end cannot be read).
+        let check_puzzle =
+            self.config.rollback && self.config.stage1_puzzle_check && stage1_attempts > 0;
+        let puzzle_at_move = check_puzzle.then(|| read_puzzle(sim)).flatten();
         for attempt in 1..=stage1_attempts {
             let puzzle_before = read_puzzle(sim);
             let run = self.stage1.run(sim, self.resting, target, &mut *self.watch);
