@@ -18,7 +18,9 @@ use dexcube_env::{
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
-use dexcube_operator::stages::{Driving, PolicyStage1, PolicyStage2, Steadying};
+use dexcube_operator::stages::{
+    Driving, PolicyStage1, PolicyStage2, Steadying, trained_control_substeps,
+};
 use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
@@ -693,6 +695,12 @@ pub struct EvalStageArgs {
     /// often. Record with seeds that no evaluation uses.
     #[arg(long, value_name = "FILE", conflicts_with = "starts")]
     record_starts: Option<PathBuf>,
+    /// Let the policy act every N physics substeps of 2 ms (the paper's 20; fewer is a
+    /// faster control rate), with as many more steps to an episode, so that each still
+    /// lasts 4 simulated seconds; placements and settling are unchanged. N divides 20.
+    /// Default: the rate the policy was trained at. Only that rate can be --record'ed.
+    #[arg(long, value_name = "N")]
+    control_substeps: Option<usize>,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -840,6 +848,19 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         EnvKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
     };
     let trained = trained_on(&prefix, args.stage)?;
+    let trained_substeps = {
+        let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
+        trained_control_substeps(&policy, &prefix)?
+    };
+    let control_substeps = args.control_substeps.unwrap_or(trained_substeps);
+    let episode_steps = dexcube_env::episode_steps(control_substeps)
+        .map_err(|e| anyhow::anyhow!("--control-substeps: {e}"))?;
+    if args.record && control_substeps != trained_substeps {
+        bail!(
+            "--record writes the policy's evaluation at the rate it was trained at ({trained_substeps} \
+             substeps), not at {control_substeps}: drop --control-substeps or --record"
+        );
+    }
     let object = match args.object {
         Some(object) => suited(args.stage, object)?,
         None => trained,
@@ -892,7 +913,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             let env: Box<dyn SimulatedEnv> = match args.stage {
                 EnvKind::Rot => {
                     let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
-                    let env = CubeRotEnv::with_scene(scene.clone(), goal).with_view(view);
+                    let env = CubeRotEnv::with_scene(scene.clone(), goal)
+                        .with_view(view)
+                        .with_control_substeps(control_substeps)
+                        .map_err(anyhow::Error::msg)?;
                     Box::new(env.with_starts(numbered(&starts)))
                 }
                 EnvKind::Layer => {
@@ -902,7 +926,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                         LayerGoals::Evaluation,
                     )
                     .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?)
-                    .with_view(view);
+                    .with_view(view)
+                    .with_control_substeps(control_substeps)
+                    .map_err(anyhow::Error::msg)?;
                     Box::new(env.with_starts(numbered(&starts)))
                 }
             };
@@ -967,10 +993,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             object.name()
         ),
     };
-    let from = match &args.starts {
+    let mut from = match &args.starts {
         Some(path) => format!("from the recorded starts in {}", path.display()),
         None => format!("seed {}", args.seed),
     };
+    if control_substeps != dexcube_sim::SUBSTEPS {
+        from += &format!(
+            ", acting every {control_substeps} substeps ({episode_steps} steps an episode)"
+        );
+    }
     println!(
         "{what}: {wins}/{episodes} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), {from}, policy {}",
         prefix.display()

@@ -261,6 +261,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             args.failed_weight
         );
     }
+    let episode_steps = args.choice.episode_steps()?;
+    let substeps = args.choice.control_substeps;
+    let faster_rate = (substeps != dexcube_sim::SUBSTEPS).then_some(substeps);
     let suffix = args
         .choice
         .named_object()?
@@ -277,7 +280,10 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         + if args.choice.intact()? { "-intact" } else { "" }
         + if args.choice.turn_ends { "-ends" } else { "" }
         + if view.misalignment { "-seen" } else { "" }
-        + if view.grip { "-grip" } else { "" };
+        + if view.grip { "-grip" } else { "" }
+        + &faster_rate
+            .map(|substeps| format!("-sub{substeps}"))
+            .unwrap_or_default();
     let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
@@ -292,6 +298,9 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     }
     let published = DdpgHerConfig::default();
     let mut config = DdpgHerConfig {
+        // Baselines' 1 - 1/T, T the episode's control steps: the same discount per simulated
+        // second at any control rate.
+        gamma: 1.0 - 1.0 / episode_steps as f64,
         batches_per_cycle: args.batches,
         her: !args.no_her,
         noise_eps: args.noise_eps.unwrap_or(published.noise_eps),
@@ -363,6 +372,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "starts": args.starts.as_ref().map(|p| p.display().to_string()),
             "start_share": args.starts.as_ref().map(|_| args.start_share),
             "failed_weight": args.starts.as_ref().map(|_| args.failed_weight),
+            "control_substeps": substeps,
         }),
     };
     eprintln!(
@@ -389,6 +399,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 CubeRotEnv::with_scene(scene.clone(), goal)
                     .with_view(view)
                     .with_starts(starts.clone())
+                    .with_control_substeps(substeps)
+                    .expect("a rate checked above")
             };
             train(make, config, &options)?
         }
@@ -404,6 +416,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_goal(goal)
                     .with_view(view)
                     .with_starts(starts.clone())
+                    .with_control_substeps(substeps)
+                    .expect("a rate checked above")
             };
             train(make, config, &options)?
         }

@@ -533,6 +533,10 @@ fn train_refuses_settings_it_cannot_run() {
         (&["rot", "--intact"], "--intact is for the physical cube"),
         (&["rot", "--object", "cube", "--turn-ends"], "--intact"),
         (
+            &["rot", "--control-substeps", "3"],
+            "--control-substeps: 3 substeps per control step: use a number that divides",
+        ),
+        (
             &["layer", "--object", "cube", "--intact"],
             "--intact is for CubeRotEnv",
         ),
@@ -918,4 +922,47 @@ fn average_writes_a_policy_eval_stage_runs_and_refuses_members_that_do_not_fit()
         "",
     );
     assert_clean_failure(&o, 2, "missing.json");
+}
+
+/// `eval-stage --control-substeps` runs a policy at another control rate and says so; the
+/// policy's card is written only at the rate it was trained at.
+#[test]
+fn eval_stage_runs_a_policy_at_another_control_rate_and_records_only_its_own() {
+    let dir = std::env::temp_dir().join("dexcube-cli-eval-stage-rate");
+    std::fs::create_dir_all(&dir).unwrap();
+    for ext in ["json", "safetensors"] {
+        std::fs::copy(
+            models().join("rot").with_extension(ext),
+            dir.join("rot").with_extension(ext),
+        )
+        .unwrap();
+    }
+    let (rot, layer) = (dir.join("rot"), models().join("layer"));
+    let eval = ["eval-stage", "rot", "--episodes", "1", "--threads", "1"];
+    let rate = [
+        "--rot-policy",
+        rot.to_str().unwrap(),
+        "--layer-policy",
+        layer.to_str().unwrap(),
+        "--control-substeps",
+        "10",
+    ];
+    let o = dexcube(&[&eval[..], &rate].concat(), "");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("acting every 10 substeps (200 steps an episode)"),
+        "{}",
+        stdout(&o)
+    );
+    let card_before = std::fs::read_to_string(dir.join("rot.json")).unwrap();
+    let o = dexcube(&[&eval[..], &rate, &["--record"]].concat(), "");
+    assert_clean_failure(
+        &o,
+        2,
+        "at the rate it was trained at (20 substeps), not at 10",
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("rot.json")).unwrap(),
+        card_before
+    );
 }

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
 use dexcube_sim::rotation::Quat;
-use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, Pose, Scene, SceneKind, Sim};
+use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, Pose, SUBSTEPS, Scene, SceneKind, Sim};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -148,6 +148,12 @@ pub struct HandObject {
     /// Where the object comes to rest on the palm, and CubeRotEnv's target position.
     pub resting: [f64; 3],
     pub steps: usize,
+    /// Physics substeps per control step while a policy acts: the paper's `SUBSTEPS`
+    /// unless set ([`HandObject::set_control_substeps`]). Placing and settling keep the
+    /// paper's, so every rate starts from the same placements.
+    control_substeps: usize,
+    /// Control steps in an episode at that rate.
+    episode_steps: usize,
 }
 
 impl HandObject {
@@ -167,7 +173,18 @@ impl HandObject {
             rng: ChaCha8Rng::seed_from_u64(0),
             resting,
             steps: 0,
+            control_substeps: SUBSTEPS,
+            episode_steps: EPISODE_STEPS,
         }
+    }
+
+    /// Acts every `substeps` physics steps instead of the paper's 20, with as many more
+    /// control steps to an episode ([`crate::episode_steps`]). Fails unless `substeps`
+    /// divides 20.
+    pub fn set_control_substeps(&mut self, substeps: usize) -> Result<(), String> {
+        self.episode_steps = crate::episode_steps(substeps)?;
+        self.control_substeps = substeps;
+        Ok(())
     }
 
     /// Re-seeds the generator if asked.
@@ -217,7 +234,10 @@ impl HandObject {
         }
         self.sim.set_action(&clipped);
         self.steps += 1;
-        self.sim.step().err().inspect(|_| self.sim.reset())
+        self.sim
+            .step_substeps(self.control_substeps)
+            .err()
+            .inspect(|_| self.sim.reset())
     }
 
     /// One environment step: the action for a control step, then the observation `observe`
@@ -243,7 +263,7 @@ impl HandObject {
         let reward = goal.compute_reward(&observation.achieved_goal, &observation.desired_goal);
         Transition {
             terminated: info.dropped || info.physics_error.is_some(),
-            truncated: self.steps >= EPISODE_STEPS,
+            truncated: self.steps >= self.episode_steps,
             observation,
             reward,
             info,

@@ -380,6 +380,14 @@ impl LayerOpEnv {
         self
     }
 
+    /// The same environment acting every `substeps` physics steps instead of the paper's 20,
+    /// an episode lasting the paper's 4 simulated seconds at any rate; fails unless
+    /// `substeps` divides 20.
+    pub fn with_control_substeps(mut self, substeps: usize) -> Result<LayerOpEnv, String> {
+        self.hand.set_control_substeps(substeps)?;
+        Ok(self)
+    }
+
     /// The same environment judged by `goal`, e.g. [`LayerGoal::square`] to also need the
     /// cube left in its good state.
     pub fn with_goal(mut self, goal: LayerGoal) -> LayerOpEnv {

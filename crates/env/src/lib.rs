@@ -45,6 +45,20 @@ pub use vec_env::VecEnv;
 /// Control steps in an episode (the paper's 100).
 pub const EPISODE_STEPS: usize = 100;
 
+/// Control steps in an episode when the policy acts every `substeps` physics substeps: the
+/// paper's 100 at its 20, and as many more at a faster rate, so that an episode lasts the
+/// paper's 4 simulated seconds at any rate. Fails unless `substeps` divides 20.
+pub fn episode_steps(substeps: usize) -> Result<usize, String> {
+    use dexcube_sim::SUBSTEPS;
+    if substeps == 0 || SUBSTEPS % substeps != 0 {
+        return Err(format!(
+            "{substeps} substeps per control step: use a number that divides the paper's \
+             {SUBSTEPS} (1, 2, 4, 5, 10 or 20)"
+        ));
+    }
+    Ok(EPISODE_STEPS * SUBSTEPS / substeps)
+}
+
 /// An observation in Gymnasium-Robotics' three parts.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Observation {

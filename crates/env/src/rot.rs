@@ -145,6 +145,14 @@ impl CubeRotEnv {
         self
     }
 
+    /// The same environment acting every `substeps` physics steps instead of the paper's 20,
+    /// an episode lasting the paper's 4 simulated seconds at any rate; fails unless
+    /// `substeps` divides 20.
+    pub fn with_control_substeps(mut self, substeps: usize) -> Result<CubeRotEnv, String> {
+        self.hand.set_control_substeps(substeps)?;
+        Ok(self)
+    }
+
     /// How many numbers Stage 1 observes without a view beyond the paper's; a trained
     /// policy's view is told from how many more it takes ([`View::after`]: 62 with the
     /// misalignment, 67 with the grip, 68 with both).

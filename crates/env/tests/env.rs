@@ -700,3 +700,35 @@ fn cube_rot_env_resets_from_recorded_starts() {
         assert!(!recorded(&never) && recorded(&always), "seed {seed}");
     }
 }
+
+/// A faster control rate acts more often within the same 4 simulated seconds, from the same
+/// placement; a rate that does not divide the paper's is refused.
+#[test]
+fn a_faster_control_rate_keeps_the_episode_four_seconds_long() {
+    let scene = Scene::load(dexcube_sim::SceneKind::Rot).unwrap();
+    let run = |substeps: usize| {
+        let mut env = CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper))
+            .with_control_substeps(substeps)
+            .unwrap();
+        let (first, _) = env.reset(Some(3));
+        let began = env.sim().time();
+        let mut steps = 0;
+        loop {
+            steps += 1;
+            let t = env.step(&[0.0; 20]);
+            if t.terminated || t.truncated {
+                assert!(t.truncated, "a still hand keeps the cube");
+                return (first.observation, steps, env.sim().time() - began);
+            }
+        }
+    };
+    let (paper_start, paper_steps, paper_time) = run(dexcube_sim::SUBSTEPS);
+    let (fast_start, fast_steps, fast_time) = run(10);
+    assert_eq!(paper_start, fast_start, "the same placement at either rate");
+    assert_eq!((paper_steps, fast_steps), (dexcube_env::EPISODE_STEPS, 200));
+    assert!((paper_time - 4.0).abs() < 1e-9 && (fast_time - 4.0).abs() < 1e-9);
+    for refused in [0, 3, 40] {
+        let env = CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper));
+        assert!(env.with_control_substeps(refused).is_err(), "{refused}");
+    }
+}

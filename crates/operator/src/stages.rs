@@ -9,14 +9,14 @@ use std::path::Path;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, CubeRotEnv, EPISODE_STEPS, Goal, LayerGoal, RecordedStart, RotGoal, RotMode,
-    SETTLE_STEPS, View, achieved_goal, is_dropped, pose_goal, rot_observation, set_down,
+    CubeLayer, CubeRotEnv, Goal, LayerGoal, RecordedStart, RotGoal, RotMode, SETTLE_STEPS, View,
+    achieved_goal, episode_steps, is_dropped, pose_goal, rot_observation, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_sim::cube::{CubeState, face_toward, turn_face_by};
 use dexcube_sim::rotation::{self, Quat};
-use dexcube_sim::{HAND_ACTUATORS, Pose, Sim};
+use dexcube_sim::{HAND_ACTUATORS, Pose, SUBSTEPS, Sim};
 use rand_chacha::ChaCha8Rng;
 
 /// The faces Stage 1 brings up, one per target pose: U, R and B (which serves the F moves).
@@ -168,6 +168,9 @@ pub const OPENING_STEPS: usize = 2 * SETTLE_STEPS;
 /// action from such an end state throws the cube off the palm; opening at once still does
 /// now and then, which `gradual_opening` avoids. These steps count as control steps, not as
 /// an action.
+///
+/// The policy acts every `substeps` physics substeps, the rate it was trained at, for its
+/// episode's 4 simulated seconds; the hand opens at the paper's rate.
 fn drive(
     sim: &mut Sim,
     act: impl FnMut(&Sim) -> Vec<f64>,
@@ -175,6 +178,7 @@ fn drive(
     gradual_opening: bool,
     stop: &mut dyn FnMut(&Sim) -> bool,
     watch: Watch,
+    substeps: usize,
 ) -> StageRun {
     let mut run = StageRun::default();
     let open = sim.scene().open_hand_action();
@@ -192,33 +196,40 @@ fn drive(
             .collect()
     };
     let never = &mut |_: &Sim| false;
-    if !advance(
-        sim,
-        settling,
-        OPENING_STEPS,
-        resting_z,
-        watch,
-        never,
-        &mut run,
-    ) {
+    let opening = Rate {
+        steps: OPENING_STEPS,
+        substeps: SUBSTEPS,
+    };
+    if !advance(sim, settling, opening, resting_z, watch, never, &mut run) {
         return run;
     }
-    advance(sim, act, EPISODE_STEPS, resting_z, watch, stop, &mut run);
+    let episode = Rate {
+        steps: episode_steps(substeps).expect("a rate checked when the policy was loaded"),
+        substeps,
+    };
+    advance(sim, act, episode, resting_z, watch, stop, &mut run);
     run
 }
 
-/// Up to `steps` control steps of `act`, ending early once `stop` says so; false if the cube
-/// dropped or the physics blew up (noted in `run`).
+/// How many control steps [`advance`] takes, and of how many physics substeps each.
+#[derive(Clone, Copy)]
+struct Rate {
+    steps: usize,
+    substeps: usize,
+}
+
+/// Up to `rate.steps` control steps of `act`, ending early once `stop` says so; false if
+/// the cube dropped or the physics blew up (noted in `run`).
 fn advance(
     sim: &mut Sim,
     mut act: impl FnMut(&Sim) -> Vec<f64>,
-    steps: usize,
+    rate: Rate,
     resting_z: f64,
     watch: Watch,
     stop: &mut dyn FnMut(&Sim) -> bool,
     run: &mut StageRun,
 ) -> bool {
-    for _ in 0..steps {
+    for _ in 0..rate.steps {
         let action = act(sim);
         let mut clipped = [0.0; HAND_ACTUATORS];
         for (c, a) in clipped.iter_mut().zip(&action) {
@@ -226,7 +237,7 @@ fn advance(
         }
         sim.set_action(&clipped);
         run.steps += 1;
-        if sim.step().is_err() {
+        if sim.step_substeps(rate.substeps).is_err() {
             run.diverged = true;
             return false;
         }
@@ -253,6 +264,9 @@ pub struct PolicyStage1 {
     /// ([`CubeRotEnv::with_view`]).
     pub view: View,
     pub driving: Driving,
+    /// Physics substeps per control step the policy was trained at
+    /// ([`trained_control_substeps`]).
+    pub control_substeps: usize,
 }
 
 impl PolicyStage1 {
@@ -297,9 +311,15 @@ impl Stage1 for PolicyStage1 {
         let goal = self.goal.desired(&pose_goal(position, target));
         let (policy, view) = (&self.policy, self.view);
         let reached = pose_reached(self.goal);
+        let substeps = self.control_substeps;
         let mut running = 0;
         let mut held = |sim: &Sim| {
-            self.driving.stage1_held_steps.is_some_and(|steps| {
+            // Held for as long as at the paper's rate, however often the policy acts.
+            let held_steps = self
+                .driving
+                .stage1_held_steps
+                .map(|s| s * SUBSTEPS / substeps);
+            held_steps.is_some_and(|steps| {
                 running = if reached(sim, position, target) {
                     running + 1
                 } else {
@@ -324,6 +344,7 @@ impl Stage1 for PolicyStage1 {
             self.driving.gradual_opening,
             &mut held,
             watch,
+            substeps,
         )
     }
 }
@@ -340,6 +361,9 @@ pub struct PolicyStage2 {
     pub view: View,
     pub resting_z: f64,
     pub driving: Driving,
+    /// Physics substeps per control step the policy was trained at
+    /// ([`trained_control_substeps`]).
+    pub control_substeps: usize,
 }
 
 impl PolicyStage2 {
@@ -361,6 +385,33 @@ impl PolicyStage2 {
     /// input beyond [`CubeLayer::PAPER_OBSERVATION`].
     pub fn trained_view(policy: &Policy, path: &Path) -> Result<View, CheckpointError> {
         trained_view(policy, path, "2 (LayerOpEnv)", CubeLayer::PAPER_OBSERVATION)
+    }
+}
+
+/// Physics substeps per control step a policy (loaded from `path`) was trained at, as its
+/// card's training environment records: the paper's 20 where the card does not say (every
+/// policy trained before the rate could be chosen).
+pub fn trained_control_substeps(policy: &Policy, path: &Path) -> Result<usize, CheckpointError> {
+    let recorded = &policy.card.metadata["environment"]["control_substeps"];
+    let Some(substeps) = recorded.as_u64() else {
+        return match recorded {
+            serde_json::Value::Null => Ok(SUBSTEPS),
+            other => Err(bad_control_substeps(path, other.to_string())),
+        };
+    };
+    let substeps = substeps as usize;
+    episode_steps(substeps)
+        .map(|_| substeps)
+        .map_err(|message| bad_control_substeps(path, message))
+}
+
+fn bad_control_substeps(path: &Path, message: String) -> CheckpointError {
+    CheckpointError::Mismatch {
+        path: path.to_path_buf(),
+        message: format!(
+            "its card's control_substeps is not a rate the environments run at ({message}): \
+             restore the card from its run"
+        ),
     }
 }
 
@@ -405,6 +456,7 @@ impl Stage2 for PolicyStage2 {
             self.driving.gradual_opening,
             &mut |_| false,
             watch,
+            self.control_substeps,
         )
     }
 }

@@ -862,3 +862,33 @@ fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
     let turned = (env.layer_angle() - std::f64::consts::FRAC_PI_2).abs() < 0.1;
     assert_eq!(starts[0].failed, !(turned && square && !run.dropped));
 }
+
+/// A Stage 1 policy runs at the control rate it was trained at: after the hand opens at the
+/// paper's rate, as many more, shorter steps as make the episode's 4 simulated seconds. A
+/// card that does not name a rate was trained at the paper's; one that names a rate no
+/// environment runs at is refused.
+#[test]
+fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
+    let (mut stages, resting) = shipped_stages();
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/rot");
+    let card_rate = |stages: &dexcube_operator::eval::LoadedStages| {
+        dexcube_operator::stages::trained_control_substeps(&stages.stage1.policy, &models)
+    };
+    assert_eq!(card_rate(&stages).unwrap(), dexcube_sim::SUBSTEPS);
+    let target = dexcube_operator::stages::stage1_target(Face::U);
+    for (substeps, policy_steps) in [(20, EPISODE_STEPS), (10, 2 * EPISODE_STEPS)] {
+        stages.stage1.policy.card.metadata["environment"]["control_substeps"] = substeps.into();
+        stages.stage1.control_substeps = card_rate(&stages).unwrap();
+        stages.stage1.driving = Driving::default();
+        let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
+        set_up_scramble(&mut sim, &[], resting);
+        let began = sim.time();
+        let run = stages.stage1.run(&mut sim, resting, target, &mut |_| {});
+        assert!(!run.dropped && !run.diverged);
+        assert_eq!(run.steps, OPENING_STEPS + policy_steps);
+        let opening = OPENING_STEPS as f64 * 0.002 * dexcube_sim::SUBSTEPS as f64;
+        assert!(((sim.time() - began) - (opening + 4.0)).abs() < 1e-9);
+    }
+    stages.stage1.policy.card.metadata["environment"]["control_substeps"] = 3.into();
+    assert!(card_rate(&stages).is_err());
+}

@@ -130,12 +130,18 @@ impl Sim {
     /// One control step: `SUBSTEPS` physics steps. Fails if the state blew up, in which case
     /// the caller should `reset`.
     pub fn step(&mut self) -> Result<(), SimError> {
+        self.step_substeps(SUBSTEPS)
+    }
+
+    /// One control step of `substeps` physics steps, for a control rate other than the
+    /// paper's; fails as [`Sim::step`] does.
+    pub fn step_substeps(&mut self, substeps: usize) -> Result<(), SimError> {
         let start = std::time::Instant::now();
         let before = self.bad_state_warnings();
         self.control_steps += 1;
         // Only the physical cube has cubelets to hold in line.
         let cubelets = self.scene.object().cube_balls();
-        for _ in 0..SUBSTEPS {
+        for _ in 0..substeps {
             if let Some(balls) = &cubelets {
                 crate::cube::apply_detent(self, balls);
             }
