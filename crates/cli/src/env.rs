@@ -110,7 +110,8 @@ pub struct EnvChoice {
     /// The policy acts every N physics substeps of 2 ms instead of the paper's 20 (a faster
     /// control rate), with as many more steps to an episode, so that each still lasts 4
     /// simulated seconds; placing and settling keep the paper's rate. N divides 20.
-    #[arg(long, value_name = "N", default_value_t = dexcube_sim::SUBSTEPS)]
+    #[arg(long, value_name = "N", default_value_t = dexcube_sim::SUBSTEPS,
+          value_parser = crate::eval::control_substeps)]
     pub control_substeps: usize,
 }
 
@@ -147,9 +148,8 @@ impl EnvChoice {
     }
 
     /// Control steps in an episode at the chosen rate: the paper's 100 at its 20 substeps.
-    pub fn episode_steps(&self) -> anyhow::Result<usize> {
-        dexcube_env::episode_steps(self.control_substeps)
-            .map_err(|e| anyhow::anyhow!("--control-substeps: {e}"))
+    pub fn episode_steps(&self) -> usize {
+        dexcube_env::episode_steps(self.control_substeps).expect("a rate checked by its parser")
     }
 
     /// What the environment shows the policy beyond the paper's observations

@@ -92,6 +92,19 @@ pub struct OperatorArgs {
     #[arg(long, value_name = "STEPS", default_value_t = 5, requires = "steady_radius",
           value_parser = clap::value_parser!(u64).range(1..=100))]
     pub steady_steps: u64,
+    /// Run Stage 1's policy acting every N physics substeps of 2 ms rather than at the rate
+    /// it was trained at (the paper's 20; fewer is faster, as many more steps to a run). N
+    /// divides 20. Off by default.
+    #[arg(long, value_name = "N", value_parser = control_substeps)]
+    pub stage1_control_substeps: Option<usize>,
+}
+
+/// A number of physics substeps per control step that the environments run at.
+pub fn control_substeps(text: &str) -> Result<usize, String> {
+    let substeps = text
+        .parse::<usize>()
+        .map_err(|_| format!("'{text}' is not a whole number of substeps"))?;
+    dexcube_env::episode_steps(substeps).map(|_| substeps)
 }
 
 /// A distance in metres, above 0 and at most 0.2 (beyond that the cube is off the palm).
@@ -151,6 +164,7 @@ impl OperatorArgs {
             radius,
             steps: self.steady_steps as usize,
         });
+        driving.stage1_control_substeps = self.stage1_control_substeps;
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
@@ -215,8 +229,11 @@ impl OperatorArgs {
                 s.steps, s.radius
             )
         });
+        let rate = driving.stage1_control_substeps.map_or(String::new(), |n| {
+            format!(", Stage 1 acting every {n} substeps")
+        });
         format!(
-            "{planner}{any_length}, opening the hand {opening}, {stage1}{steadying}{skip}{square}{puzzle_check}{first_move}"
+            "{planner}{any_length}, opening the hand {opening}, {stage1}{rate}{steadying}{skip}{square}{puzzle_check}{first_move}"
         )
     }
 
@@ -269,8 +286,11 @@ impl OperatorArgs {
                 self.steady_steps
             )
         });
+        let rate = self
+            .stage1_control_substeps
+            .map_or(String::new(), |n| format!(" --stage1-control-substeps {n}"));
         format!(
-            "{paper}{held}{opening}{already_up}{square}{puzzle_check}{first_move}{price}{steady}"
+            "{paper}{held}{opening}{already_up}{square}{puzzle_check}{first_move}{price}{steady}{rate}"
         )
     }
 }
@@ -699,7 +719,7 @@ pub struct EvalStageArgs {
     /// faster control rate), with as many more steps to an episode, so that each still
     /// lasts 4 simulated seconds; placements and settling are unchanged. N divides 20.
     /// Default: the rate the policy was trained at. Only that rate can be --record'ed.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = control_substeps)]
     control_substeps: Option<usize>,
 }
 
@@ -853,8 +873,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         trained_control_substeps(&policy, &prefix)?
     };
     let control_substeps = args.control_substeps.unwrap_or(trained_substeps);
-    let episode_steps = dexcube_env::episode_steps(control_substeps)
-        .map_err(|e| anyhow::anyhow!("--control-substeps: {e}"))?;
+    let episode_steps =
+        dexcube_env::episode_steps(control_substeps).expect("a rate checked by its parser");
     if args.record && control_substeps != trained_substeps {
         bail!(
             "--record writes the policy's evaluation at the rate it was trained at ({trained_substeps} \
@@ -1173,19 +1193,22 @@ mod tests {
         assert_eq!(mode(serde_json::json!({ "variant": "twirl" })), None);
     }
 
-    /// The check after Stage 1 is on planning for the hand and off for the paper's operator,
-    /// each unless told otherwise, and a run's record and command say which.
-    #[test]
-    fn the_puzzle_check_after_stage_1_is_the_hands_default_only() {
+    /// The operator's flags as `eval` parses them.
+    fn parse_operator(flags: &[&str]) -> Result<OperatorArgs, clap::Error> {
         #[derive(clap::Parser)]
         struct Cli {
             #[command(flatten)]
             operator: OperatorArgs,
         }
-        let operator = |flags: &[&str]| {
-            let args = std::iter::once("eval").chain(flags.iter().copied());
-            <Cli as clap::Parser>::parse_from(args).operator
-        };
+        let args = std::iter::once("eval").chain(flags.iter().copied());
+        <Cli as clap::Parser>::try_parse_from(args).map(|cli| cli.operator)
+    }
+
+    /// The check after Stage 1 is on planning for the hand and off for the paper's operator,
+    /// each unless told otherwise, and a run's record and command say which.
+    #[test]
+    fn the_puzzle_check_after_stage_1_is_the_hands_default_only() {
+        let operator = |flags: &[&str]| parse_operator(flags).unwrap();
         for (flags, checked) in [
             (&[][..], true),
             (&["--no-stage1-puzzle-check"], false),
@@ -1210,5 +1233,18 @@ mod tests {
             );
         }
         assert_eq!(operator(&["--paper-operator"]).name(), "paper");
+    }
+
+    /// Stage 1 run at another rate is part of the operator's name and flags, and is no
+    /// longer the paper's operator.
+    #[test]
+    fn stage_1_at_another_control_rate_is_named_and_flagged() {
+        let parse = parse_operator;
+        let args = parse(&["--paper-operator", "--stage1-control-substeps", "10"]).unwrap();
+        assert_eq!(args.config(true).driving.stage1_control_substeps, Some(10));
+        assert!(args.name().ends_with(", Stage 1 acting every 10 substeps"));
+        let again = parse(&args.flags().split_whitespace().collect::<Vec<_>>()).unwrap();
+        assert_eq!(again.config(true).driving.stage1_control_substeps, Some(10));
+        assert!(parse(&["--stage1-control-substeps", "3"]).is_err());
     }
 }

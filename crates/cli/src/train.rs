@@ -261,7 +261,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             args.failed_weight
         );
     }
-    let episode_steps = args.choice.episode_steps()?;
+    let episode_steps = args.choice.episode_steps();
     let substeps = args.choice.control_substeps;
     let faster_rate = (substeps != dexcube_sim::SUBSTEPS).then_some(substeps);
     let suffix = args
@@ -400,7 +400,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_view(view)
                     .with_starts(starts.clone())
                     .with_control_substeps(substeps)
-                    .expect("a rate checked above")
+                    .expect("a rate checked by its parser")
             };
             train(make, config, &options)?
         }
@@ -417,7 +417,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_view(view)
                     .with_starts(starts.clone())
                     .with_control_substeps(substeps)
-                    .expect("a rate checked above")
+                    .expect("a rate checked by its parser")
             };
             train(make, config, &options)?
         }

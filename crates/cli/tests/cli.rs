@@ -534,7 +534,7 @@ fn train_refuses_settings_it_cannot_run() {
         (&["rot", "--object", "cube", "--turn-ends"], "--intact"),
         (
             &["rot", "--control-substeps", "3"],
-            "--control-substeps: 3 substeps per control step: use a number that divides",
+            "3 substeps per control step: use a number that divides",
         ),
         (
             &["layer", "--object", "cube", "--intact"],

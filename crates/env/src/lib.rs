@@ -50,7 +50,7 @@ pub const EPISODE_STEPS: usize = 100;
 /// paper's 4 simulated seconds at any rate. Fails unless `substeps` divides 20.
 pub fn episode_steps(substeps: usize) -> Result<usize, String> {
     use dexcube_sim::SUBSTEPS;
-    if substeps == 0 || SUBSTEPS % substeps != 0 {
+    if !SUBSTEPS.is_multiple_of(substeps) {
         return Err(format!(
             "{substeps} substeps per control step: use a number that divides the paper's \
              {SUBSTEPS} (1, 2, 4, 5, 10 or 20)"

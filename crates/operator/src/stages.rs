@@ -72,6 +72,9 @@ pub struct Driving {
     pub stage1_held_steps: Option<usize>,
     /// During Stage 1, let the cube steady itself whenever it strays from its resting point.
     pub stage1_steadying: Option<Steadying>,
+    /// Run Stage 1's policy acting every this many physics substeps rather than at the rate it
+    /// was trained at: the paper's 20, or fewer for a faster rate (a divisor of 20).
+    pub stage1_control_substeps: Option<usize>,
 }
 
 impl Driving {
@@ -79,6 +82,7 @@ impl Driving {
         gradual_opening: true,
         stage1_held_steps: Some(5),
         stage1_steadying: None,
+        stage1_control_substeps: None,
     };
 }
 
@@ -204,7 +208,7 @@ fn drive(
         return run;
     }
     let episode = Rate {
-        steps: episode_steps(substeps).expect("a rate checked when the policy was loaded"),
+        steps: episode_steps(substeps).expect("a rate checked where it was chosen"),
         substeps,
     };
     advance(sim, act, episode, resting_z, watch, stop, &mut run);
@@ -311,7 +315,10 @@ impl Stage1 for PolicyStage1 {
         let goal = self.goal.desired(&pose_goal(position, target));
         let (policy, view) = (&self.policy, self.view);
         let reached = pose_reached(self.goal);
-        let substeps = self.control_substeps;
+        let substeps = self
+            .driving
+            .stage1_control_substeps
+            .unwrap_or(self.control_substeps);
         let mut running = 0;
         let mut held = |sim: &Sim| {
             // Held for as long as at the paper's rate, however often the policy acts.

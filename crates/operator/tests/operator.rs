@@ -863,10 +863,10 @@ fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
     assert_eq!(starts[0].failed, !(turned && square && !run.dropped));
 }
 
-/// A Stage 1 policy runs at the control rate it was trained at: after the hand opens at the
-/// paper's rate, as many more, shorter steps as make the episode's 4 simulated seconds. A
-/// card that does not name a rate was trained at the paper's; one that names a rate no
-/// environment runs at is refused.
+/// A Stage 1 policy runs at the control rate it was trained at, or at the one the operator
+/// asks for: after the hand opens at the paper's rate, as many more, shorter steps as make
+/// the episode's 4 simulated seconds. A card that does not name a rate was trained at the
+/// paper's; one that names a rate no environment runs at is refused.
 #[test]
 fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     let (mut stages, resting) = shipped_stages();
@@ -876,10 +876,17 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     };
     assert_eq!(card_rate(&stages).unwrap(), dexcube_sim::SUBSTEPS);
     let target = dexcube_operator::stages::stage1_target(Face::U);
-    for (substeps, policy_steps) in [(20, EPISODE_STEPS), (10, 2 * EPISODE_STEPS)] {
-        stages.stage1.policy.card.metadata["environment"]["control_substeps"] = substeps.into();
+    for (trained, asked, policy_steps) in [
+        (20, None, EPISODE_STEPS),
+        (10, None, 2 * EPISODE_STEPS),
+        (20, Some(5), 4 * EPISODE_STEPS),
+    ] {
+        stages.stage1.policy.card.metadata["environment"]["control_substeps"] = trained.into();
         stages.stage1.control_substeps = card_rate(&stages).unwrap();
-        stages.stage1.driving = Driving::default();
+        stages.stage1.driving = Driving {
+            stage1_control_substeps: asked,
+            ..Driving::default()
+        };
         let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
         set_up_scramble(&mut sim, &[], resting);
         let began = sim.time();
