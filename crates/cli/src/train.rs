@@ -188,9 +188,10 @@ pub fn average(args: AverageArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Refuses to resume a run with other recorded starts than it began with (its checkpoint's
-/// card names them), since the card would then say it trained on starts it did not.
-fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {
+/// Refuses to resume a run with other recorded starts, or at another control rate, than it
+/// began with (its checkpoint's card names them), since the card would then say it trained
+/// on starts, or at a rate, it did not.
+fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {
     // A missing or unreadable checkpoint is the trainer's to report.
     let Ok(begun) = dexcube_rl::train::RunCurve::read(run) else {
         return Ok(());
@@ -221,6 +222,18 @@ fn same_starts_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Resu
         bail!(
             "{} began with {begun}; resume it with the same, not {now}",
             run.display()
+        );
+    }
+    // Runs from before the rate could be chosen acted at the paper's.
+    let begun_rate = environment["control_substeps"]
+        .as_u64()
+        .map_or(dexcube_sim::SUBSTEPS, |n| n as usize);
+    if begun_rate != args.choice.control_substeps {
+        bail!(
+            "{} began acting every {begun_rate} substeps; resume it with --control-substeps \
+             {begun_rate}, not {}",
+            run.display(),
+            args.choice.control_substeps
         );
     }
     Ok(())
@@ -294,7 +307,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         ),
     };
     if resume {
-        same_starts_as_begun(&out, &args)?;
+        same_as_begun(&out, &args)?;
     }
     let published = DdpgHerConfig::default();
     let mut config = DdpgHerConfig {

@@ -657,9 +657,10 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
 /// that its card never names starts it did not train on: session 12's run began with none,
 /// session 13's with starts all drawn alike (a card from before the weight), and session
 /// 17's with failed starts drawn 20 times as often (a card that names the weight by Stage 1's
-/// failures, `dropped_weight`).
+/// failures, `dropped_weight`); and only at the control rate it began with (session 12's, from
+/// before the rate could be chosen, the paper's).
 #[test]
-fn train_resumes_only_with_the_starts_it_began_with() {
+fn train_resumes_only_with_the_starts_and_the_rate_it_began_with() {
     let resume = |committed_run: &str, starts: &[&str]| {
         let run = std::env::temp_dir().join(format!("dexcube-cli-resume-{committed_run}"));
         let _ = std::fs::remove_dir_all(&run);
@@ -701,6 +702,14 @@ fn train_resumes_only_with_the_starts_it_began_with() {
         ),
         2,
         "--start-share 0.5 --failed-weight 20; resume it",
+    );
+    assert_clean_failure(
+        &resume(
+            "rot-pair-cube-square-anchor5-seed0",
+            &["--control-substeps", "10"],
+        ),
+        2,
+        "began acting every 20 substeps; resume it with --control-substeps 20, not 10",
     );
 }
 

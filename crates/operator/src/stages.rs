@@ -173,8 +173,9 @@ pub const OPENING_STEPS: usize = 2 * SETTLE_STEPS;
 /// now and then, which `gradual_opening` avoids. These steps count as control steps, not as
 /// an action.
 ///
-/// The policy acts every `substeps` physics substeps, the rate it was trained at, for its
-/// episode's 4 simulated seconds; the hand opens at the paper's rate.
+/// The policy acts every `substeps` physics substeps (the rate it was trained at, unless the
+/// operator asks for another) for its episode's 4 simulated seconds; the hand opens at the
+/// paper's rate.
 fn drive(
     sim: &mut Sim,
     act: impl FnMut(&Sim) -> Vec<f64>,
