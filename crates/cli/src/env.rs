@@ -7,8 +7,8 @@ use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeRotEnv, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RotGoal,
-    RotMode, View,
+    ControlRate, CubeRotEnv, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind,
+    RecordedFailure, RotGoal, RotMode, View,
 };
 use dexcube_sim::Scene;
 use rand::{Rng, SeedableRng};
@@ -110,9 +110,8 @@ pub struct EnvChoice {
     /// The policy acts every N physics substeps of 2 ms instead of the paper's 20 (a faster
     /// control rate), with as many more steps to an episode, so that each still lasts 4
     /// simulated seconds; placing and settling keep the paper's rate. N divides 20.
-    #[arg(long, value_name = "N", default_value_t = dexcube_sim::SUBSTEPS,
-          value_parser = crate::eval::control_substeps)]
-    pub control_substeps: usize,
+    #[arg(long = "control-substeps", value_name = "N", default_value_t = ControlRate::PAPER)]
+    pub control_rate: ControlRate,
 }
 
 impl EnvChoice {
@@ -134,22 +133,15 @@ impl EnvChoice {
             EnvKind::Rot => Box::new(
                 CubeRotEnv::with_scene(scene, self.rot_goal()?)
                     .with_view(self.view()?)
-                    .with_control_substeps(self.control_substeps)
-                    .map_err(anyhow::Error::msg)?,
+                    .with_control_rate(self.control_rate),
             ),
             EnvKind::Layer => Box::new(
                 LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
                     .with_goal(self.layer_goal()?)
                     .with_view(self.view()?)
-                    .with_control_substeps(self.control_substeps)
-                    .map_err(anyhow::Error::msg)?,
+                    .with_control_rate(self.control_rate),
             ),
         })
-    }
-
-    /// Control steps in an episode at the chosen rate: the paper's 100 at its 20 substeps.
-    pub fn episode_steps(&self) -> usize {
-        dexcube_env::episode_steps(self.control_substeps).expect("a rate checked by its parser")
     }
 
     /// What the environment shows the policy beyond the paper's observations
@@ -247,10 +239,10 @@ impl EnvChoice {
             .name()
             .map(|name| format!(", {name} seen"))
             .unwrap_or_default()
-            + &if self.control_substeps == dexcube_sim::SUBSTEPS {
+            + &if self.control_rate == ControlRate::PAPER {
                 String::new()
             } else {
-                format!(", acting every {} substeps", self.control_substeps)
+                format!(", acting every {} substeps", self.control_rate)
             };
         Ok(match self.named_object()? {
             None => format!("{what}{square}{seen})"),

@@ -12,14 +12,14 @@ use clap::Args;
 use dexcube_cube::{CostTable, DistanceTable, scrambles_at_distance};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure, RecordedStart,
-    RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, is_square,
+    ControlRate, CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure,
+    RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, is_square,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
 use dexcube_operator::stages::{
-    Driving, PolicyStage1, PolicyStage2, Steadying, trained_control_substeps,
+    Driving, PolicyStage1, PolicyStage2, Steadying, trained_control_rate,
 };
 use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
@@ -95,16 +95,8 @@ pub struct OperatorArgs {
     /// Run Stage 1's policy acting every N physics substeps of 2 ms rather than at the rate
     /// it was trained at (the paper's 20; fewer is faster, as many more steps to a run). N
     /// divides 20. Off by default.
-    #[arg(long, value_name = "N", value_parser = control_substeps)]
-    pub stage1_control_substeps: Option<usize>,
-}
-
-/// A number of physics substeps per control step that the environments run at.
-pub fn control_substeps(text: &str) -> Result<usize, String> {
-    let substeps = text
-        .parse::<usize>()
-        .map_err(|_| format!("'{text}' is not a whole number of substeps"))?;
-    dexcube_env::episode_steps(substeps).map(|_| substeps)
+    #[arg(long = "stage1-control-substeps", value_name = "N")]
+    pub stage1_control_rate: Option<ControlRate>,
 }
 
 /// A distance in metres, above 0 and at most 0.2 (beyond that the cube is off the palm).
@@ -164,7 +156,7 @@ impl OperatorArgs {
             radius,
             steps: self.steady_steps as usize,
         });
-        driving.stage1_control_substeps = self.stage1_control_substeps;
+        driving.stage1_control_rate = self.stage1_control_rate;
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
@@ -229,7 +221,7 @@ impl OperatorArgs {
                 s.steps, s.radius
             )
         });
-        let rate = driving.stage1_control_substeps.map_or(String::new(), |n| {
+        let rate = driving.stage1_control_rate.map_or(String::new(), |n| {
             format!(", Stage 1 acting every {n} substeps")
         });
         format!(
@@ -287,7 +279,7 @@ impl OperatorArgs {
             )
         });
         let rate = self
-            .stage1_control_substeps
+            .stage1_control_rate
             .map_or(String::new(), |n| format!(" --stage1-control-substeps {n}"));
         format!(
             "{paper}{held}{opening}{already_up}{square}{puzzle_check}{first_move}{price}{steady}{rate}"
@@ -719,8 +711,8 @@ pub struct EvalStageArgs {
     /// faster control rate), with as many more steps to an episode, so that each still
     /// lasts 4 simulated seconds; placements and settling are unchanged. N divides 20.
     /// Default: the rate the policy was trained at. Only that rate can be --record'ed.
-    #[arg(long, value_name = "N", value_parser = control_substeps)]
-    control_substeps: Option<usize>,
+    #[arg(long = "control-substeps", value_name = "N")]
+    control_rate: Option<ControlRate>,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -868,17 +860,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         EnvKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
     };
     let trained = trained_on(&prefix, args.stage)?;
-    let trained_substeps = {
+    let trained_rate = {
         let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
-        trained_control_substeps(&policy, &prefix)?
+        trained_control_rate(&policy, &prefix)?
     };
-    let control_substeps = args.control_substeps.unwrap_or(trained_substeps);
-    let episode_steps =
-        dexcube_env::episode_steps(control_substeps).expect("a rate checked by its parser");
-    if args.record && control_substeps != trained_substeps {
+    let control_rate = args.control_rate.unwrap_or(trained_rate);
+    if args.record && control_rate != trained_rate {
         bail!(
-            "--record writes the policy's evaluation at the rate it was trained at ({trained_substeps} \
-             substeps), not at {control_substeps}: drop --control-substeps or --record"
+            "--record writes the policy's evaluation at the rate it was trained at ({trained_rate} \
+             substeps), not at {control_rate}: drop --control-substeps or --record"
         );
     }
     let object = match args.object {
@@ -935,8 +925,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
                     let env = CubeRotEnv::with_scene(scene.clone(), goal)
                         .with_view(view)
-                        .with_control_substeps(control_substeps)
-                        .map_err(anyhow::Error::msg)?;
+                        .with_control_rate(control_rate);
                     Box::new(env.with_starts(numbered(&starts)))
                 }
                 EnvKind::Layer => {
@@ -947,8 +936,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     )
                     .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?)
                     .with_view(view)
-                    .with_control_substeps(control_substeps)
-                    .map_err(anyhow::Error::msg)?;
+                    .with_control_rate(control_rate);
                     Box::new(env.with_starts(numbered(&starts)))
                 }
             };
@@ -1017,9 +1005,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         Some(path) => format!("from the recorded starts in {}", path.display()),
         None => format!("seed {}", args.seed),
     };
-    if control_substeps != dexcube_sim::SUBSTEPS {
+    if control_rate != ControlRate::PAPER {
         from += &format!(
-            ", acting every {control_substeps} substeps ({episode_steps} steps an episode)"
+            ", acting every {control_rate} substeps ({} steps an episode)",
+            control_rate.episode_steps()
         );
     }
     println!(
@@ -1241,10 +1230,16 @@ mod tests {
     fn stage_1_at_another_control_rate_is_named_and_flagged() {
         let parse = parse_operator;
         let args = parse(&["--paper-operator", "--stage1-control-substeps", "10"]).unwrap();
-        assert_eq!(args.config(true).driving.stage1_control_substeps, Some(10));
+        assert_eq!(
+            args.config(true).driving.stage1_control_rate,
+            ControlRate::every(10).ok()
+        );
         assert!(args.name().ends_with(", Stage 1 acting every 10 substeps"));
         let again = parse(&args.flags().split_whitespace().collect::<Vec<_>>()).unwrap();
-        assert_eq!(again.config(true).driving.stage1_control_substeps, Some(10));
+        assert_eq!(
+            again.config(true).driving.stage1_control_rate,
+            ControlRate::every(10).ok()
+        );
         assert!(parse(&["--stage1-control-substeps", "3"]).is_err());
     }
 }

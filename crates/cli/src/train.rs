@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::{LayerGoals, LayerMove};
-use dexcube_env::{CubeRotEnv, LayerOpEnv, StartMix, StartPick};
+use dexcube_env::{ControlRate, CubeRotEnv, LayerOpEnv, StartMix, StartPick};
 use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
 use dexcube_sim::Scene;
 
@@ -228,12 +228,12 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
     let begun_rate = environment["control_substeps"]
         .as_u64()
         .map_or(dexcube_sim::SUBSTEPS, |n| n as usize);
-    if begun_rate != args.choice.control_substeps {
+    if begun_rate != args.choice.control_rate.substeps() {
         bail!(
             "{} began acting every {begun_rate} substeps; resume it with --control-substeps \
              {begun_rate}, not {}",
             run.display(),
-            args.choice.control_substeps
+            args.choice.control_rate
         );
     }
     Ok(())
@@ -274,9 +274,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             args.failed_weight
         );
     }
-    let episode_steps = args.choice.episode_steps();
-    let substeps = args.choice.control_substeps;
-    let faster_rate = (substeps != dexcube_sim::SUBSTEPS).then_some(substeps);
+    let rate = args.choice.control_rate;
     let suffix = args
         .choice
         .named_object()?
@@ -294,9 +292,11 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         + if args.choice.turn_ends { "-ends" } else { "" }
         + if view.misalignment { "-seen" } else { "" }
         + if view.grip { "-grip" } else { "" }
-        + &faster_rate
-            .map(|substeps| format!("-sub{substeps}"))
-            .unwrap_or_default();
+        + &if rate == ControlRate::PAPER {
+            String::new()
+        } else {
+            format!("-sub{rate}")
+        };
     let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
         (_, Some(dir)) => (dir.clone(), true),
@@ -313,7 +313,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     let mut config = DdpgHerConfig {
         // Baselines' 1 - 1/T, T the episode's control steps: the same discount per simulated
         // second at any control rate.
-        gamma: 1.0 - 1.0 / episode_steps as f64,
+        gamma: 1.0 - 1.0 / rate.episode_steps() as f64,
         batches_per_cycle: args.batches,
         her: !args.no_her,
         noise_eps: args.noise_eps.unwrap_or(published.noise_eps),
@@ -385,7 +385,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "starts": args.starts.as_ref().map(|p| p.display().to_string()),
             "start_share": args.starts.as_ref().map(|_| args.start_share),
             "failed_weight": args.starts.as_ref().map(|_| args.failed_weight),
-            "control_substeps": substeps,
+            "control_substeps": rate.substeps(),
         }),
     };
     eprintln!(
@@ -412,8 +412,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 CubeRotEnv::with_scene(scene.clone(), goal)
                     .with_view(view)
                     .with_starts(starts.clone())
-                    .with_control_substeps(substeps)
-                    .expect("a rate checked by its parser")
+                    .with_control_rate(rate)
             };
             train(make, config, &options)?
         }
@@ -429,8 +428,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_goal(goal)
                     .with_view(view)
                     .with_starts(starts.clone())
-                    .with_control_substeps(substeps)
-                    .expect("a rate checked by its parser")
+                    .with_control_rate(rate)
             };
             train(make, config, &options)?
         }

@@ -124,6 +124,20 @@ fn models() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
 }
 
+/// A copy of the shipped policy `name` (weights and card) as `dir/as_name`, for a test that
+/// writes to its card; returns the copy's prefix.
+fn copy_policy(name: &str, dir: &std::path::Path, as_name: &str) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    for ext in ["json", "safetensors"] {
+        std::fs::copy(
+            models().join(name).with_extension(ext),
+            dir.join(as_name).with_extension(ext),
+        )
+        .unwrap();
+    }
+    dir.join(as_name)
+}
+
 /// The flags that point a command at the shipped policies.
 fn shipped_policy_flags() -> [String; 4] {
     let path = |name: &str| models().join(name).to_str().unwrap().to_string();
@@ -718,17 +732,9 @@ fn train_resumes_only_with_the_starts_and_the_rate_it_began_with() {
 #[test]
 fn eval_stage_records_each_object_under_its_own_name() {
     let dir = std::env::temp_dir().join("dexcube-cli-eval-stage");
-    std::fs::create_dir_all(&dir).unwrap();
     // A Stage 2 with the paper's view, which both objects can show (the shipped one also
     // sees the cube's misalignment, which only the physical cube has).
-    for ext in ["json", "safetensors"] {
-        std::fs::copy(
-            models().join("layer-anchor69").with_extension(ext),
-            dir.join("layer").with_extension(ext),
-        )
-        .unwrap();
-    }
-    let layer = dir.join("layer");
+    let layer = copy_policy("layer-anchor69", &dir, "layer");
     let layer = layer.to_str().unwrap();
     let rot = models().join("rot");
     let rot = rot.to_str().unwrap();
@@ -938,15 +944,7 @@ fn average_writes_a_policy_eval_stage_runs_and_refuses_members_that_do_not_fit()
 #[test]
 fn eval_stage_runs_a_policy_at_another_control_rate_and_records_only_its_own() {
     let dir = std::env::temp_dir().join("dexcube-cli-eval-stage-rate");
-    std::fs::create_dir_all(&dir).unwrap();
-    for ext in ["json", "safetensors"] {
-        std::fs::copy(
-            models().join("rot").with_extension(ext),
-            dir.join("rot").with_extension(ext),
-        )
-        .unwrap();
-    }
-    let (rot, layer) = (dir.join("rot"), models().join("layer"));
+    let (rot, layer) = (copy_policy("rot", &dir, "rot"), models().join("layer"));
     let eval = ["eval-stage", "rot", "--episodes", "1", "--threads", "1"];
     let rate = [
         "--rot-policy",

@@ -6,13 +6,13 @@ use std::sync::Arc;
 
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
 use dexcube_sim::rotation::Quat;
-use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, Pose, SUBSTEPS, Scene, SceneKind, Sim};
+use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, Pose, Scene, SceneKind, Sim};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::goal::Goal;
 use crate::random::standard_normal;
-use crate::{EPISODE_STEPS, Info, Observation, Transition};
+use crate::{ControlRate, Info, Observation, Transition};
 
 /// Observations shared by both environments: joint angles 24, joint velocities 24, object
 /// position 3, orientation 4, velocity 3, angular velocity 3.
@@ -148,12 +148,9 @@ pub struct HandObject {
     /// Where the object comes to rest on the palm, and CubeRotEnv's target position.
     pub resting: [f64; 3],
     pub steps: usize,
-    /// Physics substeps per control step while a policy acts: the paper's `SUBSTEPS`
-    /// unless set ([`HandObject::set_control_substeps`]). Placing and settling keep the
+    /// How often a policy acts: the paper's rate unless set. Placing and settling keep the
     /// paper's, so every rate starts from the same placements.
-    control_substeps: usize,
-    /// Control steps in an episode at that rate.
-    episode_steps: usize,
+    pub rate: ControlRate,
 }
 
 impl HandObject {
@@ -173,18 +170,8 @@ impl HandObject {
             rng: ChaCha8Rng::seed_from_u64(0),
             resting,
             steps: 0,
-            control_substeps: SUBSTEPS,
-            episode_steps: EPISODE_STEPS,
+            rate: ControlRate::PAPER,
         }
-    }
-
-    /// Acts every `substeps` physics steps instead of the paper's 20, with as many more
-    /// control steps to an episode ([`crate::episode_steps`]). Fails unless `substeps`
-    /// divides 20.
-    pub fn set_control_substeps(&mut self, substeps: usize) -> Result<(), String> {
-        self.episode_steps = crate::episode_steps(substeps)?;
-        self.control_substeps = substeps;
-        Ok(())
     }
 
     /// Re-seeds the generator if asked.
@@ -235,7 +222,7 @@ impl HandObject {
         self.sim.set_action(&clipped);
         self.steps += 1;
         self.sim
-            .step_substeps(self.control_substeps)
+            .step_substeps(self.rate.substeps())
             .err()
             .inspect(|_| self.sim.reset())
     }
@@ -263,7 +250,7 @@ impl HandObject {
         let reward = goal.compute_reward(&observation.achieved_goal, &observation.desired_goal);
         Transition {
             terminated: info.dropped || info.physics_error.is_some(),
-            truncated: self.steps >= self.episode_steps,
+            truncated: self.steps >= self.rate.episode_steps(),
             observation,
             reward,
             info,

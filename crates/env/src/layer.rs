@@ -46,7 +46,7 @@ use rand::Rng;
 use crate::goal::{Goal, LayerGoal, wrap_angle};
 use crate::hand_object::{BASE_OBSERVATION, HandObject, ObjectKind, View, canonical};
 use crate::starts::{RecordedStart, StartMix};
-use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
+use crate::{ControlRate, GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// Which layer faces where, and which way it turns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -380,12 +380,10 @@ impl LayerOpEnv {
         self
     }
 
-    /// The same environment acting every `substeps` physics steps instead of the paper's 20,
-    /// an episode lasting the paper's 4 simulated seconds at any rate; fails unless
-    /// `substeps` divides 20.
-    pub fn with_control_substeps(mut self, substeps: usize) -> Result<LayerOpEnv, String> {
-        self.hand.set_control_substeps(substeps)?;
-        Ok(self)
+    /// The same environment with the policy acting at `rate` rather than the paper's.
+    pub fn with_control_rate(mut self, rate: ControlRate) -> LayerOpEnv {
+        self.hand.rate = rate;
+        self
     }
 
     /// The same environment judged by `goal`, e.g. [`LayerGoal::square`] to also need the

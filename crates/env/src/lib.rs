@@ -45,18 +45,65 @@ pub use vec_env::VecEnv;
 /// Control steps in an episode (the paper's 100).
 pub const EPISODE_STEPS: usize = 100;
 
-/// Control steps in an episode when the policy acts every `substeps` physics substeps: the
-/// paper's 100 at its 20, and as many more at a faster rate, so that an episode lasts the
-/// paper's 4 simulated seconds at any rate. Fails unless `substeps` divides 20.
-pub fn episode_steps(substeps: usize) -> Result<usize, String> {
-    use dexcube_sim::SUBSTEPS;
-    if !SUBSTEPS.is_multiple_of(substeps) {
-        return Err(format!(
-            "{substeps} substeps per control step: use a number that divides the paper's \
-             {SUBSTEPS} (1, 2, 4, 5, 10 or 20)"
-        ));
+/// How often a policy acts: every so many physics substeps of 2 ms, the paper's 20 or fewer
+/// for a faster rate. An episode has as many more control steps at a faster rate, so that
+/// it lasts the paper's 4 simulated seconds at any rate. Only a number that divides 20 makes
+/// one, so every holder of a rate can run it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ControlRate {
+    substeps: usize,
+}
+
+impl ControlRate {
+    /// Gymnasium-Robotics' and the paper's: 20 substeps, 100 steps an episode.
+    pub const PAPER: ControlRate = ControlRate {
+        substeps: dexcube_sim::SUBSTEPS,
+    };
+
+    /// Acting every `substeps` physics substeps; fails unless `substeps` divides 20.
+    pub fn every(substeps: usize) -> Result<ControlRate, String> {
+        use dexcube_sim::SUBSTEPS;
+        if !SUBSTEPS.is_multiple_of(substeps) {
+            return Err(format!(
+                "{substeps} substeps per control step: use a number that divides the paper's \
+                 {SUBSTEPS} (1, 2, 4, 5, 10 or 20)"
+            ));
+        }
+        Ok(ControlRate { substeps })
     }
-    Ok(EPISODE_STEPS * SUBSTEPS / substeps)
+
+    /// Physics substeps per control step.
+    pub fn substeps(self) -> usize {
+        self.substeps
+    }
+
+    /// Control steps in an episode: the paper's 100 at its rate.
+    pub fn episode_steps(self) -> usize {
+        EPISODE_STEPS * dexcube_sim::SUBSTEPS / self.substeps
+    }
+}
+
+impl Default for ControlRate {
+    fn default() -> ControlRate {
+        ControlRate::PAPER
+    }
+}
+
+impl std::fmt::Display for ControlRate {
+    /// The number of substeps, as `--control-substeps` takes it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.substeps)
+    }
+}
+
+impl std::str::FromStr for ControlRate {
+    type Err = String;
+    fn from_str(text: &str) -> Result<ControlRate, String> {
+        let substeps = text
+            .parse::<usize>()
+            .map_err(|_| format!("'{text}' is not a whole number of substeps"))?;
+        ControlRate::every(substeps)
+    }
 }
 
 /// An observation in Gymnasium-Robotics' three parts.

@@ -38,7 +38,7 @@ use crate::goal::{Goal, RotGoal, RotMode};
 use crate::hand_object::{BASE_OBSERVATION, HandObject, View, base_observation, canonical};
 use crate::random::uniform_rotation;
 use crate::starts::{RecordedStart, StartMix};
-use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
+use crate::{ControlRate, GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// The paper's three Stage 1 targets, `[w, x, y, z]`.
 pub const PAPER_TARGETS: [Quat; 3] = [
@@ -145,12 +145,10 @@ impl CubeRotEnv {
         self
     }
 
-    /// The same environment acting every `substeps` physics steps instead of the paper's 20,
-    /// an episode lasting the paper's 4 simulated seconds at any rate; fails unless
-    /// `substeps` divides 20.
-    pub fn with_control_substeps(mut self, substeps: usize) -> Result<CubeRotEnv, String> {
-        self.hand.set_control_substeps(substeps)?;
-        Ok(self)
+    /// The same environment with the policy acting at `rate` rather than the paper's.
+    pub fn with_control_rate(mut self, rate: ControlRate) -> CubeRotEnv {
+        self.hand.rate = rate;
+        self
     }
 
     /// How many numbers Stage 1 observes without a view beyond the paper's; a trained

@@ -3,8 +3,9 @@
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::rot::PAPER_TARGETS;
 use dexcube_env::{
-    CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind,
-    RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, VecEnv, View, pose_goal,
+    ControlRate, CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv,
+    ObjectKind, RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, VecEnv, View,
+    pose_goal,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
@@ -708,8 +709,7 @@ fn a_faster_control_rate_keeps_the_episode_four_seconds_long() {
     let scene = Scene::load(dexcube_sim::SceneKind::Rot).unwrap();
     let run = |substeps: usize| {
         let mut env = CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper))
-            .with_control_substeps(substeps)
-            .unwrap();
+            .with_control_rate(ControlRate::every(substeps).unwrap());
         let (first, _) = env.reset(Some(3));
         let began = env.sim().time();
         let mut steps = 0;
@@ -728,7 +728,6 @@ fn a_faster_control_rate_keeps_the_episode_four_seconds_long() {
     assert_eq!((paper_steps, fast_steps), (dexcube_env::EPISODE_STEPS, 200));
     assert!((paper_time - 4.0).abs() < 1e-9 && (fast_time - 4.0).abs() < 1e-9);
     for refused in [0, 3, 40] {
-        let env = CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper));
-        assert!(env.with_control_substeps(refused).is_err(), "{refused}");
+        assert!(ControlRate::every(refused).is_err(), "{refused}");
     }
 }

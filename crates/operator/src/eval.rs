@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use crate::operator::{Operator, OperatorConfig, Planner, StageRecord, set_up_scramble};
 use crate::stages::{
     Driving, PolicyStage1, PolicyStage2, RecordingStage1, RecordingStage2, Stage1, Stage2,
-    pose_reached, trained_control_substeps,
+    pose_reached, trained_control_rate,
 };
 
 /// The paper's Table I, move distances 1 to 14.
@@ -62,14 +62,14 @@ impl PolicyFiles {
             stage1: PolicyStage1 {
                 goal: PolicyStage1::trained_goal(&rot, self.rot_mode, &self.rot)?,
                 view: PolicyStage1::trained_view(&rot, &self.rot)?,
-                control_substeps: trained_control_substeps(&rot, &self.rot)?,
+                control_rate: trained_control_rate(&rot, &self.rot)?,
                 policy: rot,
                 driving: Driving::default(),
             },
             stage2: PolicyStage2 {
                 goal: PolicyStage2::trained_goal(&layer, &self.layer)?,
                 view: PolicyStage2::trained_view(&layer, &self.layer)?,
-                control_substeps: trained_control_substeps(&layer, &self.layer)?,
+                control_rate: trained_control_rate(&layer, &self.layer)?,
                 policy: layer,
                 resting_z: resting[2],
                 driving: Driving::default(),

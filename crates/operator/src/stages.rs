@@ -9,8 +9,8 @@ use std::path::Path;
 use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
-    CubeLayer, CubeRotEnv, Goal, LayerGoal, RecordedStart, RotGoal, RotMode, SETTLE_STEPS, View,
-    achieved_goal, episode_steps, is_dropped, pose_goal, rot_observation, set_down,
+    ControlRate, CubeLayer, CubeRotEnv, Goal, LayerGoal, RecordedStart, RotGoal, RotMode,
+    SETTLE_STEPS, View, achieved_goal, is_dropped, pose_goal, rot_observation, set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -72,9 +72,8 @@ pub struct Driving {
     pub stage1_held_steps: Option<usize>,
     /// During Stage 1, let the cube steady itself whenever it strays from its resting point.
     pub stage1_steadying: Option<Steadying>,
-    /// Run Stage 1's policy acting every this many physics substeps rather than at the rate it
-    /// was trained at: the paper's 20, or fewer for a faster rate (a divisor of 20).
-    pub stage1_control_substeps: Option<usize>,
+    /// Run Stage 1's policy at this control rate rather than at the one it was trained at.
+    pub stage1_control_rate: Option<ControlRate>,
 }
 
 impl Driving {
@@ -82,7 +81,7 @@ impl Driving {
         gradual_opening: true,
         stage1_held_steps: Some(5),
         stage1_steadying: None,
-        stage1_control_substeps: None,
+        stage1_control_rate: None,
     };
 }
 
@@ -173,9 +172,8 @@ pub const OPENING_STEPS: usize = 2 * SETTLE_STEPS;
 /// now and then, which `gradual_opening` avoids. These steps count as control steps, not as
 /// an action.
 ///
-/// The policy acts every `substeps` physics substeps (the rate it was trained at, unless the
-/// operator asks for another) for its episode's 4 simulated seconds; the hand opens at the
-/// paper's rate.
+/// The policy acts at `rate` (the one it was trained at, unless the operator asks for
+/// another) for its episode's 4 simulated seconds; the hand opens at the paper's rate.
 fn drive(
     sim: &mut Sim,
     act: impl FnMut(&Sim) -> Vec<f64>,
@@ -183,7 +181,7 @@ fn drive(
     gradual_opening: bool,
     stop: &mut dyn FnMut(&Sim) -> bool,
     watch: Watch,
-    substeps: usize,
+    rate: ControlRate,
 ) -> StageRun {
     let mut run = StageRun::default();
     let open = sim.scene().open_hand_action();
@@ -201,40 +199,27 @@ fn drive(
             .collect()
     };
     let never = &mut |_: &Sim| false;
-    let opening = Rate {
-        steps: OPENING_STEPS,
-        substeps: SUBSTEPS,
-    };
+    let opening = (OPENING_STEPS, ControlRate::PAPER);
     if !advance(sim, settling, opening, resting_z, watch, never, &mut run) {
         return run;
     }
-    let episode = Rate {
-        steps: episode_steps(substeps).expect("a rate checked where it was chosen"),
-        substeps,
-    };
+    let episode = (rate.episode_steps(), rate);
     advance(sim, act, episode, resting_z, watch, stop, &mut run);
     run
 }
 
-/// How many control steps [`advance`] takes, and of how many physics substeps each.
-#[derive(Clone, Copy)]
-struct Rate {
-    steps: usize,
-    substeps: usize,
-}
-
-/// Up to `rate.steps` control steps of `act`, ending early once `stop` says so; false if
-/// the cube dropped or the physics blew up (noted in `run`).
+/// Up to `steps` control steps of `act` at `rate`, ending early once `stop` says so; false
+/// if the cube dropped or the physics blew up (noted in `run`).
 fn advance(
     sim: &mut Sim,
     mut act: impl FnMut(&Sim) -> Vec<f64>,
-    rate: Rate,
+    (steps, rate): (usize, ControlRate),
     resting_z: f64,
     watch: Watch,
     stop: &mut dyn FnMut(&Sim) -> bool,
     run: &mut StageRun,
 ) -> bool {
-    for _ in 0..rate.steps {
+    for _ in 0..steps {
         let action = act(sim);
         let mut clipped = [0.0; HAND_ACTUATORS];
         for (c, a) in clipped.iter_mut().zip(&action) {
@@ -242,7 +227,7 @@ fn advance(
         }
         sim.set_action(&clipped);
         run.steps += 1;
-        if sim.step_substeps(rate.substeps).is_err() {
+        if sim.step_substeps(rate.substeps()).is_err() {
             run.diverged = true;
             return false;
         }
@@ -269,9 +254,8 @@ pub struct PolicyStage1 {
     /// ([`CubeRotEnv::with_view`]).
     pub view: View,
     pub driving: Driving,
-    /// Physics substeps per control step the policy was trained at
-    /// ([`trained_control_substeps`]).
-    pub control_substeps: usize,
+    /// The control rate the policy was trained at ([`trained_control_rate`]).
+    pub control_rate: ControlRate,
 }
 
 impl PolicyStage1 {
@@ -316,17 +300,17 @@ impl Stage1 for PolicyStage1 {
         let goal = self.goal.desired(&pose_goal(position, target));
         let (policy, view) = (&self.policy, self.view);
         let reached = pose_reached(self.goal);
-        let substeps = self
+        let rate = self
             .driving
-            .stage1_control_substeps
-            .unwrap_or(self.control_substeps);
+            .stage1_control_rate
+            .unwrap_or(self.control_rate);
+        // Held for as long as at the paper's rate, however often the policy acts.
+        let held_steps = self
+            .driving
+            .stage1_held_steps
+            .map(|steps| steps * SUBSTEPS / rate.substeps());
         let mut running = 0;
         let mut held = |sim: &Sim| {
-            // Held for as long as at the paper's rate, however often the policy acts.
-            let held_steps = self
-                .driving
-                .stage1_held_steps
-                .map(|s| s * SUBSTEPS / substeps);
             held_steps.is_some_and(|steps| {
                 running = if reached(sim, position, target) {
                     running + 1
@@ -352,7 +336,7 @@ impl Stage1 for PolicyStage1 {
             self.driving.gradual_opening,
             &mut held,
             watch,
-            substeps,
+            rate,
         )
     }
 }
@@ -369,9 +353,8 @@ pub struct PolicyStage2 {
     pub view: View,
     pub resting_z: f64,
     pub driving: Driving,
-    /// Physics substeps per control step the policy was trained at
-    /// ([`trained_control_substeps`]).
-    pub control_substeps: usize,
+    /// The control rate the policy was trained at ([`trained_control_rate`]).
+    pub control_rate: ControlRate,
 }
 
 impl PolicyStage2 {
@@ -396,21 +379,18 @@ impl PolicyStage2 {
     }
 }
 
-/// Physics substeps per control step a policy (loaded from `path`) was trained at, as its
-/// card's training environment records: the paper's 20 where the card does not say (every
-/// policy trained before the rate could be chosen).
-pub fn trained_control_substeps(policy: &Policy, path: &Path) -> Result<usize, CheckpointError> {
+/// The control rate a policy (loaded from `path`) was trained at, as its card's training
+/// environment records it (`control_substeps`): the paper's where the card does not say
+/// (every policy trained before the rate could be chosen).
+pub fn trained_control_rate(policy: &Policy, path: &Path) -> Result<ControlRate, CheckpointError> {
     let recorded = &policy.card.metadata["environment"]["control_substeps"];
     let Some(substeps) = recorded.as_u64() else {
         return match recorded {
-            serde_json::Value::Null => Ok(SUBSTEPS),
+            serde_json::Value::Null => Ok(ControlRate::PAPER),
             other => Err(bad_control_substeps(path, other.to_string())),
         };
     };
-    let substeps = substeps as usize;
-    episode_steps(substeps)
-        .map(|_| substeps)
-        .map_err(|message| bad_control_substeps(path, message))
+    ControlRate::every(substeps as usize).map_err(|message| bad_control_substeps(path, message))
 }
 
 fn bad_control_substeps(path: &Path, message: String) -> CheckpointError {
@@ -464,7 +444,7 @@ impl Stage2 for PolicyStage2 {
             self.driving.gradual_opening,
             &mut |_| false,
             watch,
-            self.control_substeps,
+            self.control_rate,
         )
     }
 }

@@ -6,7 +6,8 @@ use dexcube_cube::Face;
 use dexcube_cube::{CostTable, DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{
-    CubeRotEnv, EPISODE_STEPS, LayerOpEnv, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick,
+    ControlRate, CubeRotEnv, EPISODE_STEPS, LayerOpEnv, RotGoal, RotMode, SimulatedEnv, StartMix,
+    StartPick,
 };
 use dexcube_operator::stages::{
     Driving, KinematicStage1, KinematicStage2, OPENING_STEPS, RecordingStage1, RecordingStage2,
@@ -872,9 +873,12 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     let (mut stages, resting) = shipped_stages();
     let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/rot");
     let card_rate = |stages: &dexcube_operator::eval::LoadedStages| {
-        dexcube_operator::stages::trained_control_substeps(&stages.stage1.policy, &models)
+        dexcube_operator::stages::trained_control_rate(&stages.stage1.policy, &models)
     };
-    assert_eq!(card_rate(&stages).unwrap(), dexcube_sim::SUBSTEPS);
+    assert_eq!(
+        card_rate(&stages).unwrap().substeps(),
+        dexcube_sim::SUBSTEPS
+    );
     let target = dexcube_operator::stages::stage1_target(Face::U);
     for (trained, asked, policy_steps) in [
         (20, None, EPISODE_STEPS),
@@ -882,9 +886,9 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
         (20, Some(5), 4 * EPISODE_STEPS),
     ] {
         stages.stage1.policy.card.metadata["environment"]["control_substeps"] = trained.into();
-        stages.stage1.control_substeps = card_rate(&stages).unwrap();
+        stages.stage1.control_rate = card_rate(&stages).unwrap();
         stages.stage1.driving = Driving {
-            stage1_control_substeps: asked,
+            stage1_control_rate: asked.map(|n| ControlRate::every(n).unwrap()),
             ..Driving::default()
         };
         let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
