@@ -33,7 +33,13 @@ enum Command {
     Render(render::RenderArgs),
     Train(train::TrainArgs),
     Plot(train::PlotArgs),
-    Average(train::AverageArgs),
+    /// Averages the actor weights of several policies of one run, such as its snapshots, into
+    /// one policy (stochastic weight averaging), with their normalisers pooled.
+    Average(train::CombineArgs),
+    /// Joins several policies of one stage into an ensemble that acts with the mean of their
+    /// actions. The first gives the card (label, environment, view) and must observe at least
+    /// as much as the others, which read the leading part of its observation.
+    Ensemble(train::CombineArgs),
     Eval(eval::EvalArgs),
     EvalStage(eval::EvalStageArgs),
     /// Inspects the training environments.
@@ -61,7 +67,8 @@ fn main() -> ExitCode {
         Command::Env(command) => env::run(command),
         Command::Train(args) => train::run(args),
         Command::Plot(args) => train::plot(args),
-        Command::Average(args) => train::average(args),
+        Command::Average(args) => train::combine(train::Combination::Average, args),
+        Command::Ensemble(args) => train::combine(train::Combination::Ensemble, args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),
         Command::Bench(command) => bench::run(command),

@@ -156,32 +156,48 @@ pub fn plot(args: PlotArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Averages the actor weights of several policies of one run, such as its snapshots, into one
-/// policy (stochastic weight averaging), with their normalisers pooled.
+/// Several policies made into one: `average` (their weights) or `ensemble` (their actions).
 #[derive(Args)]
-pub struct AverageArgs {
-    /// Policies to average, each as the path of its .safetensors and .json less the extension.
+pub struct CombineArgs {
+    /// The policies, each as the path of its .safetensors and .json less the extension.
     #[arg(required = true, num_args = 2..)]
     policies: Vec<PathBuf>,
-    /// Where to write the average (PATH.safetensors and PATH.json).
+    /// Where to write the result (PATH.safetensors and PATH.json).
     #[arg(long)]
     out: PathBuf,
 }
 
-pub fn average(args: AverageArgs) -> anyhow::Result<ExitCode> {
+/// How `combine` makes one policy of several.
+#[derive(Clone, Copy)]
+pub enum Combination {
+    /// The mean of the actors' weights, with their normalisers pooled (stochastic weight
+    /// averaging over one run's snapshots).
+    Average,
+    /// The mean of the actors' actions, each member keeping its own weights and normalisers.
+    Ensemble,
+}
+
+pub fn combine(how: Combination, args: CombineArgs) -> anyhow::Result<ExitCode> {
     let members: Vec<String> = args
         .policies
         .iter()
         .map(|p| p.display().to_string())
         .collect();
+    let (name, verb) = match how {
+        Combination::Average => ("average", "averaged"),
+        Combination::Ensemble => ("ensemble", "joined"),
+    };
     let command = format!(
-        "dexcube average {} --out {}",
+        "dexcube {name} {} --out {}",
         members.join(" "),
         args.out.display()
     );
-    dexcube_rl::Policy::average(&args.policies, &args.out, &command)?;
+    match how {
+        Combination::Average => dexcube_rl::Policy::average(&args.policies, &args.out, &command)?,
+        Combination::Ensemble => dexcube_rl::Policy::ensemble(&args.policies, &args.out, &command)?,
+    }
     println!(
-        "averaged {} policies into {}",
+        "{verb} {} policies into {}",
         members.len(),
         args.out.display()
     );

@@ -892,51 +892,80 @@ fn plot_draws_runs_across_seeds_and_refuses_a_seed_twice() {
     assert_clean_failure(&o, 2, "is not a training run's folder");
 }
 
+/// `average` (of weights) and `ensemble` (of actions) each write a policy that eval-stage
+/// runs, and refuse members that do not fit, naming them.
 #[test]
-fn average_writes_a_policy_eval_stage_runs_and_refuses_members_that_do_not_fit() {
-    let dir = std::env::temp_dir().join("dexcube-cli-average");
+fn average_and_ensemble_write_a_policy_eval_stage_runs_and_refuse_members_that_do_not_fit() {
+    let dir = std::env::temp_dir().join("dexcube-cli-combine");
     let _ = std::fs::remove_dir_all(&dir);
-    let out = dir.join("rot-average");
-    let out = out.to_str().unwrap();
-    let (rot, layer) = (models().join("rot"), models().join("layer"));
-    let (rot, layer) = (rot.to_str().unwrap(), layer.to_str().unwrap());
-    let o = dexcube(&["average", rot, rot, "--out", out], "");
-    assert!(o.status.success(), "{}", stderr(&o));
-    let card: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(format!("{out}.json")).unwrap()).unwrap();
-    assert_eq!(card["metadata"]["environment"]["mode"], "pair");
-    assert!(
-        card["metadata"]["command"]
-            .as_str()
-            .unwrap()
-            .starts_with("dexcube average ")
-    );
-    let o = dexcube(
-        &[
-            "eval-stage",
+    let [rot, layer, layer_blind] =
+        ["rot", "layer", "layer-td3-27"].map(|name| models().join(name));
+    let [rot, layer, layer_blind] = [&rot, &layer, &layer_blind].map(|p| p.to_str().unwrap());
+    let cases = [
+        // The shipped Stage 1 with itself; a Stage 2 among the members.
+        (
+            "average",
             "rot",
-            "--episodes",
-            "2",
-            "--threads",
-            "1",
-            "--rot-policy",
-            out,
-            "--layer-policy",
-            layer,
-        ],
-        "",
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stdout(&o).contains("pair mode"), "{}", stdout(&o));
+            [rot, rot],
+            [rot, layer],
+            "layer.safetensors does not fit",
+        ),
+        // The seen Stage 2 with a blind one, which reads the leading 62 of its 63 numbers; the
+        // blind one first cannot give the seen one its misalignment.
+        (
+            "ensemble",
+            "layer",
+            [layer, layer_blind],
+            [layer_blind, layer],
+            "the first observes the most",
+        ),
+    ];
+    for (command, stage, members, misfit, refusal) in cases {
+        let out = dir.join(format!("{command}-{stage}"));
+        let out = out.to_str().unwrap();
+        let o = dexcube(&[command, members[0], members[1], "--out", out], "");
+        assert!(o.status.success(), "{}", stderr(&o));
+        let card: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(format!("{out}.json")).unwrap()).unwrap();
+        assert_eq!(card["metadata"]["environment"]["env"], stage, "{command}");
+        assert!(
+            card["metadata"]["command"]
+                .as_str()
+                .unwrap()
+                .starts_with(&format!("dexcube {command} "))
+        );
+        let (rot_policy, layer_policy) = if stage == "rot" {
+            (out, layer)
+        } else {
+            (rot, out)
+        };
+        let o = dexcube(
+            &[
+                "eval-stage",
+                stage,
+                "--episodes",
+                "2",
+                "--threads",
+                "1",
+                "--rot-policy",
+                rot_policy,
+                "--layer-policy",
+                layer_policy,
+            ],
+            "",
+        );
+        assert!(o.status.success(), "{command}: {}", stderr(&o));
+        assert!(stdout(&o).contains("/2 ="), "{}", stdout(&o));
 
-    let o = dexcube(&["average", rot, layer, "--out", out], "");
-    assert_clean_failure(&o, 2, "layer.safetensors does not fit");
-    let missing = dir.join("missing");
-    let o = dexcube(
-        &["average", rot, missing.to_str().unwrap(), "--out", out],
-        "",
-    );
-    assert_clean_failure(&o, 2, "missing.json");
+        let o = dexcube(&[command, misfit[0], misfit[1], "--out", out], "");
+        assert_clean_failure(&o, 2, refusal);
+        let missing = dir.join("missing");
+        let o = dexcube(
+            &[command, members[0], missing.to_str().unwrap(), "--out", out],
+            "",
+        );
+        assert_clean_failure(&o, 2, "missing.json");
+    }
 }
 
 /// `eval-stage --control-substeps` runs a policy at another control rate and says so; the

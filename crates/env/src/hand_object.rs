@@ -67,6 +67,17 @@ impl View {
         View::ALL.into_iter().find(|view| view.size() == extra)
     }
 
+    /// Whether this view's numbers are the leading part of `wider`'s, so that a policy trained
+    /// with this view can read its inputs from the start of `wider`'s observation (views append
+    /// the misalignment first, then the grip).
+    pub fn leads(self, wider: View) -> bool {
+        let misalignment_only = View {
+            misalignment: true,
+            grip: false,
+        };
+        self == View::PAPER || self == wider || (self == misalignment_only && wider.misalignment)
+    }
+
     /// What the view adds, in words for labels: `None` for the paper's, else "misalignment",
     /// "grip" or "misalignment and grip".
     pub fn name(self) -> Option<&'static str> {

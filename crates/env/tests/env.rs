@@ -382,6 +382,39 @@ fn assert_views_told_by_size(stage_paper: usize, paper: usize) {
     );
 }
 
+/// A view leads a wider one ([`View::leads`], what lets an ensemble's narrower members read
+/// the first member's observation) exactly when its observation is the leading part of the
+/// wider one's, from the same start.
+#[test]
+fn a_view_leads_another_when_its_observation_is_the_start_of_the_other() {
+    let views = [
+        View::PAPER,
+        seeing(true, false),
+        seeing(false, true),
+        seeing(true, true),
+    ];
+    let observation = |view| {
+        let mut env = LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
+            .unwrap()
+            .with_goal(LayerGoal::square())
+            .with_view(view);
+        env.reset(Some(3));
+        env.step(&[0.3; 20]).observation.observation
+    };
+    let seen = views.map(observation);
+    for (narrow, narrow_seen) in views.iter().zip(&seen) {
+        for (wide, wide_seen) in views.iter().zip(&seen) {
+            if narrow_seen.len() > wide_seen.len() {
+                continue;
+            }
+            let leading = wide_seen[..narrow_seen.len()] == narrow_seen[..];
+            assert_eq!(narrow.leads(*wide), leading, "{narrow:?} within {wide:?}");
+        }
+    }
+    assert!(seeing(true, false).leads(seeing(true, true)));
+    assert!(!seeing(false, true).leads(seeing(true, true)));
+}
+
 /// Stage 1 may see the misalignment as Stage 2 does: its 61 observations gain the same last
 /// number. The rigid cube, always square, refuses to show it.
 #[test]

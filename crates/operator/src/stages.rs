@@ -411,15 +411,34 @@ fn trained_view(
     stage: &str,
     paper: usize,
 ) -> Result<View, CheckpointError> {
-    let size = policy.card.dims.observation;
-    View::after(paper, size).ok_or_else(|| CheckpointError::Mismatch {
-        path: path.to_path_buf(),
-        message: format!(
-            "a Stage {stage} policy observes {paper} numbers (one more with the cube's \
-             misalignment, six more with the grip), this one {size}: pass a policy trained \
-             for that stage"
-        ),
-    })
+    let view_of = |size: usize| {
+        View::after(paper, size).ok_or_else(|| CheckpointError::Mismatch {
+            path: path.to_path_buf(),
+            message: format!(
+                "a Stage {stage} policy observes {paper} numbers (one more with the cube's \
+                 misalignment, six more with the grip), this one {size}: pass a policy trained \
+                 for that stage"
+            ),
+        })
+    };
+    let view = view_of(policy.card.dims.observation)?;
+    for partner in &policy.card.partners {
+        let partner_view = view_of(partner.dims.observation)?;
+        if !partner_view.leads(view) {
+            return Err(CheckpointError::Mismatch {
+                path: path.to_path_buf(),
+                message: format!(
+                    "its member {} sees the {}, which is not the leading part of what its first \
+                     member sees (the {}): join them with the member that sees more first, or \
+                     with views that extend one another",
+                    partner.source.display(),
+                    partner_view.name().unwrap_or("paper's observations"),
+                    view.name().unwrap_or("paper's observations"),
+                ),
+            });
+        }
+    }
+    Ok(view)
 }
 
 /// The cube-frame face whose outward normal points most nearly up in the world.

@@ -1,6 +1,11 @@
 //! A trained policy as shipped: the actor's weights (`NAME.safetensors`) and a JSON beside it
 //! (`NAME.json`) with the sizes, the normalisers, the training configuration and whatever
 //! metrics the trainer recorded. It acts without the critic or any optimiser state.
+//!
+//! A policy may also be an ensemble ([`Policy::ensemble`]): the first member's actor and card,
+//! with the other members' actors beside it in the same files (their tensors named
+//! `partner{i}.…`, their sizes and normalisers in the card's `partners`). It acts with the
+//! mean of its members' deterministic actions.
 
 use std::path::{Path, PathBuf};
 
@@ -23,12 +28,51 @@ pub struct PolicyCard {
     pub goal_norm: Normalizer,
     /// Free-form facts: environment, seed, steps, wall time, evaluation.
     pub metadata: serde_json::Value,
+    /// The other members of an ensemble; empty for a single policy.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub partners: Vec<PartnerCard>,
+}
+
+/// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
+/// with. It reads the first `dims.observation` numbers of the ensemble's observation, so a
+/// member trained on the paper's observations can join one whose view appends more.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PartnerCard {
+    pub dims: Dims,
+    pub hidden: Vec<usize>,
+    pub observation_norm: Normalizer,
+    pub goal_norm: Normalizer,
+    /// The policy it was taken from, as given when the ensemble was made.
+    pub source: PathBuf,
 }
 
 pub struct Policy {
     pub card: PolicyCard,
     actor: Mlp,
+    /// The partners' actors, in the order of `card.partners`.
+    partners: Vec<Mlp>,
     device: Device,
+}
+
+/// The tensor-name prefix of an ensemble's `i`-th partner.
+fn partner_prefix(i: usize) -> String {
+    format!("partner{i}.")
+}
+
+/// A policy's card and weights as stored, read for combining with others.
+fn read_stored(prefix: &Path) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>), CheckpointError> {
+    let (weights, card_path) = policy_paths(prefix);
+    let card: PolicyCard = checkpoint::load_json(&card_path)?;
+    let tensors = checkpoint::load_tensors(&weights)?;
+    Ok((weights, card, tensors))
+}
+
+/// The error for policies that cannot be combined into one at `out`.
+fn cannot_combine(out: &Path, message: String) -> CheckpointError {
+    CheckpointError::Mismatch {
+        path: out.to_path_buf(),
+        message,
+    }
 }
 
 /// `prefix.safetensors` and `prefix.json`.
@@ -53,6 +97,7 @@ impl Policy {
             observation_norm: agent.observation_norm.clone(),
             goal_norm: agent.goal_norm.clone(),
             metadata,
+            partners: Vec::new(),
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -71,17 +116,18 @@ impl Policy {
     pub fn average(members: &[PathBuf], out: &Path, command: &str) -> Result<(), CheckpointError> {
         let mut loaded = Vec::with_capacity(members.len());
         for member in members {
-            let (weights, card_path) = policy_paths(member);
-            let card: PolicyCard = checkpoint::load_json(&card_path)?;
-            let mut tensors = checkpoint::load_tensors(&weights)?;
+            let (weights, card, mut tensors) = read_stored(member)?;
+            if !card.partners.is_empty() {
+                return Err(cannot_combine(
+                    &weights,
+                    "an ensemble's weights cannot be averaged; average single policies".to_string(),
+                ));
+            }
             tensors.sort_by(|a, b| a.name.cmp(&b.name));
             loaded.push((weights, card, tensors));
         }
         let Some(((_, first_card, first), rest)) = loaded.split_first() else {
-            return Err(CheckpointError::Mismatch {
-                path: out.to_path_buf(),
-                message: "no policies to average".to_string(),
-            });
+            return Err(cannot_combine(out, "no policies to average".to_string()));
         };
         // The tensors' names and shapes are the network's sizes; the normalisers, pooled
         // below, check the environment's.
@@ -95,10 +141,10 @@ impl Policy {
         let mut mean = first.clone();
         for (weights, _, tensors) in rest {
             if layout(tensors) != first_layout {
-                return Err(CheckpointError::Mismatch {
-                    path: weights.clone(),
-                    message: format!("other network sizes than {}", members[0].display()),
-                });
+                return Err(cannot_combine(
+                    weights,
+                    format!("other network sizes than {}", members[0].display()),
+                ));
             }
             for (total, tensor) in mean.iter_mut().zip(tensors) {
                 for (t, v) in total.values.iter_mut().zip(&tensor.values) {
@@ -112,9 +158,11 @@ impl Policy {
         }
         let pooled = |pick: fn(&PolicyCard) -> &Normalizer| {
             let members: Vec<&Normalizer> = loaded.iter().map(|(_, card, _)| pick(card)).collect();
-            Normalizer::pooled(&members).ok_or_else(|| CheckpointError::Mismatch {
-                path: out.to_path_buf(),
-                message: "the members' normalisers differ in size or settings".to_string(),
+            Normalizer::pooled(&members).ok_or_else(|| {
+                cannot_combine(
+                    out,
+                    "the members' normalisers differ in size or settings".to_string(),
+                )
             })
         };
         let head = &first_card.metadata;
@@ -134,42 +182,158 @@ impl Policy {
         checkpoint::save_json(&card_path, &card)
     }
 
+    /// Writes at `out` an ensemble of the policies at `members`: one policy that acts with the
+    /// mean of their deterministic actions, each member reading its own inputs through its own
+    /// normalisers. The first member gives the card (its configuration, label and environment,
+    /// so the ensemble is run as it would be) and must observe at least as much as each other
+    /// member: the others read the leading part of its observation. Members must share the goal
+    /// and the action sizes. The card records the members and `command`, the command that
+    /// joined them.
+    pub fn ensemble(members: &[PathBuf], out: &Path, command: &str) -> Result<(), CheckpointError> {
+        let Some((first, rest)) = members.split_first() else {
+            return Err(cannot_combine(out, "no policies to join".to_string()));
+        };
+        let (_, head, mut tensors) = read_stored(first)?;
+        let mut partners = Vec::with_capacity(rest.len());
+        for (i, member) in members.iter().enumerate() {
+            let (weights, card, member_tensors) = read_stored(member)?;
+            if !card.partners.is_empty() {
+                return Err(cannot_combine(
+                    &weights,
+                    "it is an ensemble already; join single policies".to_string(),
+                ));
+            }
+            let dims = card.dims;
+            if dims.goal != head.dims.goal
+                || dims.action != head.dims.action
+                || dims.observation > head.dims.observation
+            {
+                return Err(cannot_combine(
+                    &weights,
+                    format!(
+                        "its sizes {dims:?} do not fit the first member's {:?}: members share \
+                         the goal and the action, and the first observes the most",
+                        head.dims
+                    ),
+                ));
+            }
+            if i == 0 {
+                continue;
+            }
+            let prefix = partner_prefix(partners.len());
+            tensors.extend(member_tensors.into_iter().map(|t| NamedTensor {
+                name: format!("{prefix}{}", t.name),
+                ..t
+            }));
+            partners.push(PartnerCard {
+                dims,
+                hidden: card.config.hidden,
+                observation_norm: card.observation_norm,
+                goal_norm: card.goal_norm,
+                source: member.clone(),
+            });
+        }
+        let card = PolicyCard {
+            metadata: serde_json::json!({
+                "label": format!(
+                    "ensemble of {}, first {}",
+                    members.len(),
+                    head.metadata["label"].as_str().unwrap_or("an unlabelled policy")
+                ),
+                "environment": head.metadata["environment"],
+                "ensemble": members,
+                "command": command,
+            }),
+            partners,
+            ..head
+        };
+        let (weights, card_path) = policy_paths(out);
+        checkpoint::save_tensors(&weights, &tensors)?;
+        checkpoint::save_json(&card_path, &card)
+    }
+
     /// Loads the policy at `prefix` onto `device`.
     pub fn load(prefix: &Path, device: &Device) -> Result<Policy, CheckpointError> {
-        let (weights, card_path) = policy_paths(prefix);
-        let card: PolicyCard = checkpoint::load_json(&card_path)?;
-        let tensors = checkpoint::load_tensors(&weights)?;
-        let Dims {
-            observation,
-            goal,
-            action,
-        } = card.dims;
-        let actor = Mlp::new(observation + goal, &card.config.hidden, action, device);
-        let actor = params::write(actor, &tensors, |_, given| given.to_vec()).map_err(|e| {
-            CheckpointError::Mismatch {
-                path: weights.clone(),
-                message: e.to_string(),
-            }
-        })?;
+        let (weights, card, tensors) = read_stored(prefix)?;
+        let build = |dims: Dims, hidden: &[usize], tensors: &[NamedTensor]| {
+            let actor = Mlp::new(dims.observation + dims.goal, hidden, dims.action, device);
+            params::write(actor, tensors, |_, given| given.to_vec())
+                .map_err(|e| cannot_combine(&weights, e.to_string()))
+        };
+        let actor = build(card.dims, &card.config.hidden, &tensors)?;
+        let partners = card
+            .partners
+            .iter()
+            .enumerate()
+            .map(|(i, partner)| {
+                let prefix = partner_prefix(i);
+                let own: Vec<NamedTensor> = tensors
+                    .iter()
+                    .filter_map(|t| {
+                        let name = t.name.strip_prefix(&prefix)?;
+                        Some(NamedTensor {
+                            name: name.to_string(),
+                            ..t.clone()
+                        })
+                    })
+                    .collect();
+                build(partner.dims, &partner.hidden, &own)
+            })
+            .collect::<Result<_, _>>()?;
         Ok(Policy {
             card,
             actor,
+            partners,
             device: device.clone(),
         })
     }
 
-    /// The deterministic action for one observation and goal.
+    /// How many actors act together: 1, or an ensemble's members.
+    pub fn members(&self) -> usize {
+        1 + self.partners.len()
+    }
+
+    /// The deterministic action for one observation and goal: an ensemble's is the mean of its
+    /// members'.
     pub fn act(&self, observation: &[f64], goal: &[f64]) -> Vec<f64> {
         let card = &self.card;
+        let mut total = self.member_action(
+            &self.actor,
+            (&card.observation_norm, &card.goal_norm),
+            observation,
+            goal,
+        );
+        for (actor, partner) in self.partners.iter().zip(&card.partners) {
+            let action = self.member_action(
+                actor,
+                (&partner.observation_norm, &partner.goal_norm),
+                observation,
+                goal,
+            );
+            total.iter_mut().zip(action).for_each(|(t, a)| *t += a);
+        }
+        let scale = 1.0 / self.members() as f64;
+        total.iter_mut().for_each(|t| *t *= scale);
+        total
+    }
+
+    /// One actor's action, from the leading part of the observation that its normaliser takes.
+    fn member_action(
+        &self,
+        actor: &Mlp,
+        (observation_norm, goal_norm): (&Normalizer, &Normalizer),
+        observation: &[f64],
+        goal: &[f64],
+    ) -> Vec<f64> {
         let x = network_inputs(
-            &card.observation_norm,
-            &card.goal_norm,
+            observation_norm,
+            goal_norm,
             observation,
             goal,
             1,
             &self.device,
         );
-        let out = self.actor.forward(x).tanh().into_data().convert::<f64>();
+        let out = actor.forward(x).tanh().into_data().convert::<f64>();
         out.try_to_vec::<f64>().unwrap_or_default()
     }
 }

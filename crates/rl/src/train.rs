@@ -663,7 +663,17 @@ fn read_policy(
     prefix: &Path,
 ) -> Result<(Vec<crate::params::NamedTensor>, crate::policy::PolicyCard), TrainError> {
     let (weights, card_path) = crate::policy::policy_paths(prefix);
-    let card = checkpoint::load_json(&card_path)?;
+    let card: crate::policy::PolicyCard = checkpoint::load_json(&card_path)?;
+    if !card.partners.is_empty() {
+        return Err(mismatch(
+            prefix,
+            format!(
+                "it is an ensemble of {} policies, which trains as none of them: start from one \
+                 of its members (its card's metadata.ensemble names them)",
+                card.partners.len() + 1
+            ),
+        ));
+    }
     Ok((checkpoint::load_tensors(&weights)?, card))
 }
 

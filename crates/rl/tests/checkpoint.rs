@@ -618,6 +618,107 @@ fn a_weight_average_of_snapshots_holds_their_mean_weights_and_pooled_normalisers
     );
 }
 
+/// An ensemble acts with the mean of its members' actions, each member reading the leading part
+/// of the observation through its own normalisers; it is refused where it cannot act as one,
+/// and cannot be averaged, joined again or trained from.
+#[test]
+fn an_ensemble_acts_with_the_mean_of_its_members_actions() {
+    let dir = fresh_dir("dexcube-rl-ensemble");
+    train(PointMassEnv::default, config(), &options(&dir, 4, false)).unwrap();
+    let wider = fresh_dir("dexcube-rl-ensemble-wider");
+    let make = || PointMassWithRadius {
+        env: PointMassEnv::default(),
+        radius_in: RadiusIn::Observation,
+    };
+    train(make, config(), &options(&wider, 1, false)).unwrap();
+    let members = [
+        wider.join("policy"),
+        dir.join("snapshots/epoch-0001"),
+        dir.join("snapshots/epoch-0003"),
+    ];
+    let out = dir.join("ensemble");
+    Policy::ensemble(&members, &out, "dexcube ensemble ...").unwrap();
+    let device = burn::prelude::Device::flex();
+    let loaded = members
+        .each_ref()
+        .map(|p| Policy::load(p, &device).unwrap());
+    let ensemble = Policy::load(&out, &device).unwrap();
+    assert_eq!(ensemble.members(), 3);
+    assert_eq!(
+        ensemble.card.dims, loaded[0].card.dims,
+        "the first member's sizes"
+    );
+    let metadata = &ensemble.card.metadata;
+    assert_eq!(
+        metadata["environment"],
+        loaded[0].card.metadata["environment"]
+    );
+    assert_eq!(metadata["ensemble"][2], members[2].display().to_string());
+    assert_eq!(metadata["command"], "dexcube ensemble ...");
+    assert!(
+        metadata["label"]
+            .as_str()
+            .unwrap()
+            .starts_with("ensemble of 3, first ")
+    );
+    let mut env = make();
+    for seed in 0..5 {
+        let (obs, _) = env.reset(Some(seed));
+        assert_eq!(obs.observation.len(), 3);
+        let actions: Vec<Vec<f64>> = loaded
+            .iter()
+            .map(|p| p.act(&obs.observation, &obs.desired_goal))
+            .collect();
+        assert_eq!(
+            actions[1],
+            loaded[1].act(&obs.observation[..2], &obs.desired_goal),
+            "a narrower member reads the leading part"
+        );
+        assert_ne!(actions[1], actions[2], "the members differ");
+        let together = ensemble.act(&obs.observation, &obs.desired_goal);
+        for (k, a) in together.iter().enumerate() {
+            let mean = actions.iter().map(|x| x[k]).sum::<f64>() / 3.0;
+            assert!(
+                (a - mean).abs() < 1e-6,
+                "action {k}: {a} against the mean {mean}"
+            );
+        }
+    }
+
+    let refused = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
+        result.expect_err("refused").to_string()
+    };
+    let narrower_first = [members[1].clone(), members[0].clone()];
+    let err = refused(Policy::ensemble(
+        &narrower_first,
+        &out.with_file_name("x"),
+        "",
+    ));
+    assert!(err.contains("first observes the most"), "{err}");
+    let err = refused(Policy::ensemble(
+        &[out.clone(), members[1].clone()],
+        &dir.join("x"),
+        "",
+    ));
+    assert!(err.contains("an ensemble already"), "{err}");
+    let err = refused(Policy::average(
+        &[members[1].clone(), out.clone()],
+        &dir.join("x"),
+        "",
+    ));
+    assert!(err.contains("cannot be averaged"), "{err}");
+    let from_ensemble = TrainOptions {
+        init_from: Some(dir.clone()),
+        init_actor: Some(out.clone()),
+        ..options(&fresh_dir("dexcube-rl-ensemble-warm"), 1, false)
+    };
+    let err = train(PointMassEnv::default, config(), &from_ensemble)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("ensemble of 3 policies"), "{err}");
+}
+
 #[test]
 fn a_td3_run_keeps_its_second_critic_and_a_warm_start_from_ddpg_makes_a_new_one() {
     let dir = fresh_dir("dexcube-rl-td3");
