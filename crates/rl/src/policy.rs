@@ -67,10 +67,10 @@ fn read_stored(prefix: &Path) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>),
     Ok((weights, card, tensors))
 }
 
-/// The error for policies that cannot be combined into one at `out`.
-fn cannot_combine(out: &Path, message: String) -> CheckpointError {
+/// The error for stored weights or cards at `path` that do not fit what they are used for.
+fn mismatch(path: &Path, message: String) -> CheckpointError {
     CheckpointError::Mismatch {
-        path: out.to_path_buf(),
+        path: path.to_path_buf(),
         message,
     }
 }
@@ -118,7 +118,7 @@ impl Policy {
         for member in members {
             let (weights, card, mut tensors) = read_stored(member)?;
             if !card.partners.is_empty() {
-                return Err(cannot_combine(
+                return Err(mismatch(
                     &weights,
                     "an ensemble's weights cannot be averaged; average single policies".to_string(),
                 ));
@@ -127,7 +127,7 @@ impl Policy {
             loaded.push((weights, card, tensors));
         }
         let Some(((_, first_card, first), rest)) = loaded.split_first() else {
-            return Err(cannot_combine(out, "no policies to average".to_string()));
+            return Err(mismatch(out, "no policies to average".to_string()));
         };
         // The tensors' names and shapes are the network's sizes; the normalisers, pooled
         // below, check the environment's.
@@ -141,7 +141,7 @@ impl Policy {
         let mut mean = first.clone();
         for (weights, _, tensors) in rest {
             if layout(tensors) != first_layout {
-                return Err(cannot_combine(
+                return Err(mismatch(
                     weights,
                     format!("other network sizes than {}", members[0].display()),
                 ));
@@ -159,7 +159,7 @@ impl Policy {
         let pooled = |pick: fn(&PolicyCard) -> &Normalizer| {
             let members: Vec<&Normalizer> = loaded.iter().map(|(_, card, _)| pick(card)).collect();
             Normalizer::pooled(&members).ok_or_else(|| {
-                cannot_combine(
+                mismatch(
                     out,
                     "the members' normalisers differ in size or settings".to_string(),
                 )
@@ -191,24 +191,29 @@ impl Policy {
     /// joined them.
     pub fn ensemble(members: &[PathBuf], out: &Path, command: &str) -> Result<(), CheckpointError> {
         let Some((first, rest)) = members.split_first() else {
-            return Err(cannot_combine(out, "no policies to join".to_string()));
+            return Err(mismatch(out, "no policies to join".to_string()));
         };
-        let (_, head, mut tensors) = read_stored(first)?;
-        let mut partners = Vec::with_capacity(rest.len());
-        for (i, member) in members.iter().enumerate() {
-            let (weights, card, member_tensors) = read_stored(member)?;
-            if !card.partners.is_empty() {
-                return Err(cannot_combine(
+        let single = |member: &Path| {
+            let (weights, card, tensors) = read_stored(member)?;
+            if card.partners.is_empty() {
+                Ok((weights, card, tensors))
+            } else {
+                Err(mismatch(
                     &weights,
                     "it is an ensemble already; join single policies".to_string(),
-                ));
+                ))
             }
+        };
+        let (_, head, mut tensors) = single(first)?;
+        let mut partners = Vec::with_capacity(rest.len());
+        for member in rest {
+            let (weights, card, member_tensors) = single(member)?;
             let dims = card.dims;
             if dims.goal != head.dims.goal
                 || dims.action != head.dims.action
                 || dims.observation > head.dims.observation
             {
-                return Err(cannot_combine(
+                return Err(mismatch(
                     &weights,
                     format!(
                         "its sizes {dims:?} do not fit the first member's {:?}: members share \
@@ -216,9 +221,6 @@ impl Policy {
                         head.dims
                     ),
                 ));
-            }
-            if i == 0 {
-                continue;
             }
             let prefix = partner_prefix(partners.len());
             tensors.extend(member_tensors.into_iter().map(|t| NamedTensor {
@@ -258,7 +260,7 @@ impl Policy {
         let build = |dims: Dims, hidden: &[usize], tensors: &[NamedTensor]| {
             let actor = Mlp::new(dims.observation + dims.goal, hidden, dims.action, device);
             params::write(actor, tensors, |_, given| given.to_vec())
-                .map_err(|e| cannot_combine(&weights, e.to_string()))
+                .map_err(|e| mismatch(&weights, e.to_string()))
         };
         let actor = build(card.dims, &card.config.hidden, &tensors)?;
         let partners = card
