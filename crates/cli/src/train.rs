@@ -8,7 +8,8 @@ use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{ControlRate, CubeRotEnv, LayerOpEnv, StartMix, StartPick};
-use dexcube_rl::{DdpgHerConfig, TrainOptions, train};
+use dexcube_rl::checkpoint::CheckpointError;
+use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
 use crate::env::{EnvChoice, EnvKind, starts_for};
@@ -183,19 +184,17 @@ pub fn combine(how: Combination, args: CombineArgs) -> anyhow::Result<ExitCode> 
         .iter()
         .map(|p| p.display().to_string())
         .collect();
-    let (name, verb) = match how {
-        Combination::Average => ("average", "averaged"),
-        Combination::Ensemble => ("ensemble", "joined"),
+    type Make = fn(&[PathBuf], &std::path::Path, &str) -> Result<(), CheckpointError>;
+    let (name, verb, make): (_, _, Make) = match how {
+        Combination::Average => ("average", "averaged", Policy::average),
+        Combination::Ensemble => ("ensemble", "joined", Policy::ensemble),
     };
     let command = format!(
         "dexcube {name} {} --out {}",
         members.join(" "),
         args.out.display()
     );
-    match how {
-        Combination::Average => dexcube_rl::Policy::average(&args.policies, &args.out, &command)?,
-        Combination::Ensemble => dexcube_rl::Policy::ensemble(&args.policies, &args.out, &command)?,
-    }
+    make(&args.policies, &args.out, &command)?;
     println!(
         "{verb} {} policies into {}",
         members.len(),

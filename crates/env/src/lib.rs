@@ -83,12 +83,6 @@ impl ControlRate {
     }
 }
 
-impl Default for ControlRate {
-    fn default() -> ControlRate {
-        ControlRate::PAPER
-    }
-}
-
 impl std::fmt::Display for ControlRate {
     /// The number of substeps, as `--control-substeps` takes it.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

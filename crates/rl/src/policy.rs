@@ -67,6 +67,27 @@ fn read_stored(prefix: &Path) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>),
     Ok((weights, card, tensors))
 }
 
+/// The same for a single policy, refusing an ensemble with a message saying it cannot be
+/// `used` ("averaged", "joined", "trained from"): whatever combines or trains from policies
+/// takes each member's one actor.
+pub(crate) fn read_single(
+    prefix: &Path,
+    used: &str,
+) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>), CheckpointError> {
+    let (weights, card, tensors) = read_stored(prefix)?;
+    if card.partners.is_empty() {
+        return Ok((weights, card, tensors));
+    }
+    Err(mismatch(
+        &weights,
+        format!(
+            "it is an ensemble already, an ensemble of {} policies, and cannot be {used}: use \
+             one of its members (its card's metadata.ensemble names them)",
+            card.partners.len() + 1
+        ),
+    ))
+}
+
 /// The error for stored weights or cards at `path` that do not fit what they are used for.
 fn mismatch(path: &Path, message: String) -> CheckpointError {
     CheckpointError::Mismatch {
@@ -116,13 +137,7 @@ impl Policy {
     pub fn average(members: &[PathBuf], out: &Path, command: &str) -> Result<(), CheckpointError> {
         let mut loaded = Vec::with_capacity(members.len());
         for member in members {
-            let (weights, card, mut tensors) = read_stored(member)?;
-            if !card.partners.is_empty() {
-                return Err(mismatch(
-                    &weights,
-                    "an ensemble's weights cannot be averaged; average single policies".to_string(),
-                ));
-            }
+            let (weights, card, mut tensors) = read_single(member, "averaged")?;
             tensors.sort_by(|a, b| a.name.cmp(&b.name));
             loaded.push((weights, card, tensors));
         }
@@ -193,21 +208,10 @@ impl Policy {
         let Some((first, rest)) = members.split_first() else {
             return Err(mismatch(out, "no policies to join".to_string()));
         };
-        let single = |member: &Path| {
-            let (weights, card, tensors) = read_stored(member)?;
-            if card.partners.is_empty() {
-                Ok((weights, card, tensors))
-            } else {
-                Err(mismatch(
-                    &weights,
-                    "it is an ensemble already; join single policies".to_string(),
-                ))
-            }
-        };
-        let (_, head, mut tensors) = single(first)?;
+        let (_, head, mut tensors) = read_single(first, "joined")?;
         let mut partners = Vec::with_capacity(rest.len());
         for member in rest {
-            let (weights, card, member_tensors) = single(member)?;
+            let (weights, card, member_tensors) = read_single(member, "joined")?;
             let dims = card.dims;
             if dims.goal != head.dims.goal
                 || dims.action != head.dims.action

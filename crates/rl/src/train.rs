@@ -662,19 +662,8 @@ fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> 
 fn read_policy(
     prefix: &Path,
 ) -> Result<(Vec<crate::params::NamedTensor>, crate::policy::PolicyCard), TrainError> {
-    let (weights, card_path) = crate::policy::policy_paths(prefix);
-    let card: crate::policy::PolicyCard = checkpoint::load_json(&card_path)?;
-    if !card.partners.is_empty() {
-        return Err(mismatch(
-            prefix,
-            format!(
-                "it is an ensemble of {} policies, which trains as none of them: start from one \
-                 of its members (its card's metadata.ensemble names them)",
-                card.partners.len() + 1
-            ),
-        ));
-    }
-    Ok((checkpoint::load_tensors(&weights)?, card))
+    let (_, card, tensors) = crate::policy::read_single(prefix, "trained from")?;
+    Ok((tensors, card))
 }
 
 /// The error for saved networks at `path` that do not fit, saying why.
