@@ -10,17 +10,14 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use anyhow::{Context, bail};
 use clap::Args;
 use dexcube_cube::{CostTable, DistanceTable, scrambles_at_distance};
-use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    ControlRate, CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RecordedFailure,
-    RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, is_square,
+    ControlRate, Info, ObjectKind, RecordedFailure, RecordedStart, RotMode, SimulatedEnv, StartMix,
+    StartPick, is_square,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
 };
-use dexcube_operator::stages::{
-    Driving, PolicyStage1, PolicyStage2, Steadying, trained_control_rate,
-};
+use dexcube_operator::stages::{Driving, Steadying};
 use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
@@ -29,7 +26,8 @@ use dexcube_sim::cube::{read_puzzle, turned_since};
 use dexcube_sim::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::env::{EnvKind, original_object, starts_for, suited};
+use crate::env::{EnvKind, starts_for};
+use crate::stage::{StageSetup, meets_paper_test};
 
 /// Which operator runs the plan.
 #[derive(Args, Clone, Copy)]
@@ -598,7 +596,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
 /// Runs `work(state, k)` for every k in 0..n on `threads` threads. Each thread makes its own
 /// state with `init` (a policy, an environment) and takes the next k as it frees up. The
 /// first error is returned once every thread has stopped.
-fn in_parallel<S>(
+pub(crate) fn in_parallel<S>(
     threads: usize,
     n: usize,
     init: impl Fn() -> anyhow::Result<S> + Sync,
@@ -783,16 +781,6 @@ impl Ending {
     }
 }
 
-/// Whether a step met the paper's test, position and angle within `thresholds`, with the
-/// object on the palm. A policy trained on a stricter test (Stage 2 left square) is still
-/// judged by the paper's here; the good state is counted beside it.
-fn meets_paper_test(info: &Info, (position, angle): (f64, f64)) -> bool {
-    !info.dropped
-        && info.physics_error.is_none()
-        && info.position_error < position
-        && info.angle_error < angle
-}
-
 /// One deterministic episode of an atomic action: its last step's info, whether the object
 /// ended square (a physical cube in its good state; any other object always), and the
 /// longest run of consecutive steps at the goal before the end (or before a drop).
@@ -845,37 +833,21 @@ const HOLDS: [usize; 3] = [1, 10, 25];
 
 pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let files = args.policies.files()?;
-    let prefix = match args.stage {
-        EnvKind::Rot => files.rot.clone(),
-        EnvKind::Layer => files.layer.clone(),
-    };
     let endings: [AtomicUsize; 7] = Default::default();
     let held: [AtomicUsize; HOLDS.len()] = Default::default();
     let wins_out_of_square = AtomicUsize::new(0);
     // Stage 1 episodes that kept the cube and ended with a layer turned, and of them successes.
     let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let rot_goal = RotGoal::paper(files.rot_mode);
-    let thresholds = match args.stage {
-        EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
-        EnvKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
-    };
-    let trained = trained_on(&prefix, args.stage)?;
-    let trained_rate = {
-        let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
-        trained_control_rate(&policy, &prefix)?
-    };
-    let control_rate = args.control_rate.unwrap_or(trained_rate);
-    if args.record && control_rate != trained_rate {
+    let setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
+    let (thresholds, control_rate) = (setup.thresholds, setup.control_rate);
+    if args.record && control_rate != setup.trained_rate {
         bail!(
-            "--record writes the policy's evaluation at the rate it was trained at ({trained_rate} \
-             substeps), not at {control_rate}: drop --control-substeps or --record"
+            "--record writes the policy's evaluation at the rate it was trained at ({} \
+             substeps), not at {control_rate}: drop --control-substeps or --record",
+            setup.trained_rate
         );
     }
-    let object = match args.object {
-        Some(object) => suited(args.stage, object)?,
-        None => trained,
-    };
-    let scene = Scene::load(object.scene())?;
+    let (prefix, object, scene) = (setup.prefix.clone(), setup.object, setup.scene.clone());
     let (starts, failure) = match &args.starts {
         None => (None, args.stage.recorded_failure()),
         Some(path) => {
@@ -907,39 +879,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         episodes,
         || -> anyhow::Result<(Policy, Box<dyn SimulatedEnv>)> {
             let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
-            let view = match args.stage {
-                EnvKind::Rot => PolicyStage1::trained_view(&policy, &prefix)?,
-                EnvKind::Layer => PolicyStage2::trained_view(&policy, &prefix)?,
-            };
-            if let Some(seen) = view.name()
-                && object != ObjectKind::Cube
-            {
-                bail!(
-                    "{} was trained seeing the {seen}, a view of the physical cube: run it \
-                     with --object cube",
-                    prefix.display()
-                );
-            }
-            let env: Box<dyn SimulatedEnv> = match args.stage {
-                EnvKind::Rot => {
-                    let goal = PolicyStage1::trained_goal(&policy, files.rot_mode, &prefix)?;
-                    let env = CubeRotEnv::with_scene(scene.clone(), goal)
-                        .with_view(view)
-                        .with_control_rate(control_rate);
-                    Box::new(env.with_starts(numbered(&starts)))
-                }
-                EnvKind::Layer => {
-                    let env = LayerOpEnv::with_scene(
-                        scene.clone(),
-                        LayerMove::UPrime,
-                        LayerGoals::Evaluation,
-                    )
-                    .with_goal(PolicyStage2::trained_goal(&policy, &prefix)?)
-                    .with_view(view)
-                    .with_control_rate(control_rate);
-                    Box::new(env.with_starts(numbered(&starts)))
-                }
-            };
+            let env = setup.env(&policy, numbered(&starts))?;
             Ok((policy, env))
         },
         |(policy, env), k| {
@@ -1072,24 +1012,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     }
     if args.record {
         let wins = (wins, wins - wins_out_of_square);
-        record(&prefix, &args, (object, object == trained), wins, (lo, hi))?;
+        record(
+            &prefix,
+            &args,
+            (object, object == setup.trained_object),
+            wins,
+            (lo, hi),
+        )?;
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// The object a policy was trained on, from its card (cards from before the object was an
-/// option were trained on the rigid cube for Stage 1 and on the block for Stage 2).
-fn trained_on(policy: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
-    let path = policy.with_extension("json");
-    let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
-        .with_context(|| format!("reading {}", path.display()))?;
-    let object = match card["metadata"]["environment"]["object"].as_str() {
-        Some(name) => name
-            .parse()
-            .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))?,
-        None => original_object(env),
-    };
-    suited(env, object)
 }
 
 /// Writes the result into the policy's card: as `evaluation` on the object it was trained on

@@ -6,11 +6,13 @@ mod bench_env;
 mod bench_rl;
 mod bench_sim;
 mod demo;
+mod distil;
 mod env;
 mod eval;
 mod net;
 mod render;
 mod solve;
+mod stage;
 mod train;
 
 use std::process::ExitCode;
@@ -40,6 +42,9 @@ enum Command {
     /// actions. The first gives the card (label, environment, view) and must observe at least
     /// as much as the others, which read the leading part of its observation.
     Ensemble(train::CombineArgs),
+    /// Teaches one actor to act as a stage policy does (an ensemble, typically) by DAgger:
+    /// the teacher labels every state of episodes run first by itself, then by the student.
+    Distil(distil::DistilArgs),
     Eval(eval::EvalArgs),
     EvalStage(eval::EvalStageArgs),
     /// Inspects the training environments.
@@ -69,6 +74,7 @@ fn main() -> ExitCode {
         Command::Plot(args) => train::plot(args),
         Command::Average(args) => train::combine(train::Combination::Average, args),
         Command::Ensemble(args) => train::combine(train::Combination::Ensemble, args),
+        Command::Distil(args) => distil::run(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),
         Command::Bench(command) => bench::run(command),

@@ -587,7 +587,7 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
     for (stage, init, view, env_args, observation, seen, other_object) in [
         (
             "rot",
-            "rot",
+            "rot-dropw20",
             &["--see-misalignment", "--see-grip"][..],
             &["--mode", "pair"][..],
             68,
@@ -899,10 +899,11 @@ fn average_and_ensemble_write_a_policy_eval_stage_runs_and_refuse_members_that_d
     let dir = std::env::temp_dir().join("dexcube-cli-combine");
     let _ = std::fs::remove_dir_all(&dir);
     let [rot, layer, layer_blind] =
-        ["rot", "layer", "layer-td3-27"].map(|name| models().join(name));
+        ["rot-dropw20", "layer", "layer-td3-27"].map(|name| models().join(name));
     let [rot, layer, layer_blind] = [&rot, &layer, &layer_blind].map(|p| p.to_str().unwrap());
     let cases = [
-        // The shipped Stage 1 with itself; a Stage 2 among the members.
+        // A single Stage 1 (the default before the ensemble) with itself; a Stage 2 among the
+        // members.
         (
             "average",
             "rot",
@@ -1001,4 +1002,82 @@ fn eval_stage_runs_a_policy_at_another_control_rate_and_records_only_its_own() {
         std::fs::read_to_string(dir.join("rot.json")).unwrap(),
         card_before
     );
+}
+
+/// `distil` teaches one actor to act as the shipped Stage 1 ensemble does: it writes the
+/// student as a single policy that eval-stage runs, and one row per DAgger round; bad
+/// arguments and a missing teacher fail cleanly.
+#[test]
+fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
+    let dir = std::env::temp_dir().join("dexcube-cli-distil");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let (rot, layer) = (rot.to_str().unwrap(), layer.to_str().unwrap());
+    let out = dir.join("student");
+    let out = out.to_str().unwrap();
+    let distil = |rounds: &str, teacher: &str| {
+        dexcube(
+            &[
+                "distil",
+                "rot",
+                "--rot-policy",
+                teacher,
+                "--layer-policy",
+                layer,
+                "--out",
+                out,
+                "--rounds",
+                rounds,
+                "--episodes",
+                "2",
+                "--epochs",
+                "1",
+                "--threads",
+                "1",
+            ],
+            "",
+        )
+    };
+    let o = distil("2", rot);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{out}.json")).unwrap()).unwrap();
+    assert!(card.get("partners").is_none(), "the student is one actor");
+    let metadata = &card["metadata"];
+    assert!(
+        metadata["label"]
+            .as_str()
+            .unwrap()
+            .starts_with("distilled from ensemble of 3")
+    );
+    assert_eq!(metadata["environment"]["env"], "rot");
+    let rounds = metadata["distillation"]["rounds"].as_array().unwrap();
+    assert_eq!(rounds.len(), 2);
+    assert_eq!(rounds[0]["acting"], "teacher");
+    assert_eq!(rounds[1]["acting"], "student");
+    assert!(rounds[1]["rows"].as_u64().unwrap() > rounds[0]["rows"].as_u64().unwrap());
+    let csv = std::fs::read_to_string(dir.join("student-rounds.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    let o = dexcube(
+        &[
+            "eval-stage",
+            "rot",
+            "--episodes",
+            "2",
+            "--threads",
+            "1",
+            "--rot-policy",
+            out,
+            "--layer-policy",
+            layer,
+        ],
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("/2 ="), "{}", stdout(&o));
+
+    assert_clean_failure(&distil("0", rot), 2, "--rounds, --episodes and --epochs");
+    let missing = dir.join("missing");
+    assert_clean_failure(&distil("1", missing.to_str().unwrap()), 2, "missing.json");
 }

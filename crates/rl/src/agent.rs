@@ -449,7 +449,8 @@ impl Agent {
     }
 }
 
-fn scalar(t: &Tensor<1>) -> f64 {
+/// A one-element tensor's value (NaN if it has none).
+pub(crate) fn scalar(t: &Tensor<1>) -> f64 {
     t.to_data()
         .convert::<f64>()
         .try_to_vec::<f64>()

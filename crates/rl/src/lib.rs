@@ -12,6 +12,7 @@
 //! - [`start_file`]: recorded Stage 1 starts on disk, to train and evaluate from;
 //! - [`seeds`]: learning curves across seeds, mean ± one standard deviation;
 //! - [`policy`]: a trained actor as shipped, with its normalisers;
+//! - [`distil`]: one actor fitted to act as another policy (an ensemble) does, by DAgger;
 //! - [`point_mass`]: a small reaching task that proves the learner in seconds.
 //!
 //! Networks run on burn's `flex` CPU backend with one intra-op thread; the code names no
@@ -20,6 +21,7 @@
 pub mod agent;
 pub mod checkpoint;
 pub mod config;
+pub mod distil;
 pub mod networks;
 pub mod normalizer;
 pub mod params;

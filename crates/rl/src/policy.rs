@@ -48,10 +48,10 @@ pub struct PartnerCard {
 
 pub struct Policy {
     pub card: PolicyCard,
-    actor: Mlp,
+    pub(crate) actor: Mlp,
     /// The partners' actors, in the order of `card.partners`.
     partners: Vec<Mlp>,
-    device: Device,
+    pub(crate) device: Device,
 }
 
 /// The tensor-name prefix of an ensemble's `i`-th partner.
@@ -292,6 +292,40 @@ impl Policy {
             partners,
             device: device.clone(),
         })
+    }
+
+    /// The first member alone (an ensemble's first policy, or a single policy itself), as a
+    /// single policy with the card it had, `metadata` in place of its card's.
+    pub fn first_member(&self, metadata: serde_json::Value) -> Policy {
+        let mut single = self.with_actor(self.actor.clone());
+        single.card.metadata = metadata;
+        single
+    }
+
+    /// The first member's card and normalisers with `actor`'s weights, as a single policy.
+    pub(crate) fn with_actor(&self, actor: Mlp) -> Policy {
+        Policy {
+            card: PolicyCard {
+                partners: Vec::new(),
+                ..self.card.clone()
+            },
+            actor,
+            partners: Vec::new(),
+            device: self.device.clone(),
+        }
+    }
+
+    /// Writes a single policy at `prefix` (`prefix.safetensors` and `prefix.json`).
+    pub fn write(&self, prefix: &Path) -> Result<(), CheckpointError> {
+        if !self.partners.is_empty() {
+            return Err(mismatch(
+                prefix,
+                "an ensemble is written by `Policy::ensemble`, from its members".to_string(),
+            ));
+        }
+        let (weights, card_path) = policy_paths(prefix);
+        checkpoint::save_tensors(&weights, &params::read(&self.actor))?;
+        checkpoint::save_json(&card_path, &self.card)
     }
 
     /// How many actors act together: 1, or an ensemble's members.

@@ -762,3 +762,71 @@ fn a_td3_run_keeps_its_second_critic_and_a_warm_start_from_ddpg_makes_a_new_one(
     let second = by_name(run.agent.twin_networks().unwrap()[0].clone());
     assert!(dexcube_rl::params::l1_distance(&second, &critic) > 0.0);
 }
+
+/// A student fitted by DAgger's labels learns to act as the ensemble that taught it, keeps the
+/// first member's card, and is written and read back as a single policy.
+#[test]
+fn a_distilled_student_acts_as_its_ensemble_does() {
+    use dexcube_rl::distil::{Demonstrations, DistilConfig, fit};
+    let dir = fresh_dir("dexcube-rl-distil");
+    train(PointMassEnv::default, config(), &options(&dir, 4, false)).unwrap();
+    let members = [
+        dir.join("snapshots/epoch-0001"),
+        dir.join("snapshots/epoch-0003"),
+    ];
+    let teacher_path = dir.join("ensemble");
+    Policy::ensemble(&members, &teacher_path, "").unwrap();
+    let device = burn::prelude::Device::flex();
+    let teacher = Policy::load(&teacher_path, &device).unwrap();
+    let student = teacher.first_member(serde_json::json!({"label": "student"}));
+    assert_eq!(student.members(), 1);
+    let first = Policy::load(&members[0], &device).unwrap();
+
+    // The student's own episodes, labelled by the teacher (DAgger's later rounds).
+    let mut env = PointMassEnv::default();
+    let mut demonstrations = Demonstrations::default();
+    for seed in 0..20 {
+        let (mut obs, _) = env.reset(Some(seed));
+        loop {
+            let taught =
+                demonstrations.label(&teacher, &student, &obs.observation, &obs.desired_goal);
+            assert_eq!(taught, teacher.act(&obs.observation, &obs.desired_goal));
+            let own = student.act(&obs.observation, &obs.desired_goal);
+            assert_eq!(own, first.act(&obs.observation, &obs.desired_goal));
+            let t = env.step(&own);
+            if t.terminated || t.truncated {
+                break;
+            }
+            obs = t.observation;
+        }
+    }
+    assert!(demonstrations.rows() >= 20);
+    let before = demonstrations.mean_squared_error(&student);
+    assert!(
+        before > 0.0,
+        "the members differ, so the first alone is not the ensemble"
+    );
+    let config = DistilConfig {
+        epochs: 100,
+        ..DistilConfig::default()
+    };
+    let fitted = fit(&student, &demonstrations, config, 0).unwrap();
+    let after = demonstrations.mean_squared_error(&fitted);
+    assert!(
+        after < before / 4.0,
+        "the fit closes most of the gap: {before} -> {after}"
+    );
+    assert_eq!(fitted.card.observation_norm, student.card.observation_norm);
+
+    let out = dir.join("student");
+    fitted.write(&out).unwrap();
+    let read_back = Policy::load(&out, &device).unwrap();
+    assert_eq!(read_back.card.metadata["label"], "student");
+    let (obs, _) = env.reset(Some(99));
+    assert_eq!(
+        read_back.act(&obs.observation, &obs.desired_goal),
+        fitted.act(&obs.observation, &obs.desired_goal)
+    );
+    let err = teacher.write(&dir.join("x")).err().unwrap().to_string();
+    assert!(err.contains("written by `Policy::ensemble`"), "{err}");
+}

@@ -1,0 +1,145 @@
+//! One atomic action run on its own, outside the operator, as `eval-stage` and `distil` run
+//! it: the object and control rate a stage policy was trained at, the environment it acts in
+//! (with the goal and view its card names), and the paper's test of an episode's end.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use anyhow::{Context, bail};
+use dexcube_env::layer::LayerGoals;
+use dexcube_env::{
+    ControlRate, CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode,
+    SimulatedEnv, StartMix,
+};
+use dexcube_operator::eval::PolicyFiles;
+use dexcube_operator::stages::{PolicyStage1, PolicyStage2, trained_control_rate};
+use dexcube_rl::Policy;
+use dexcube_sim::Scene;
+
+use crate::env::{EnvKind, original_object, suited};
+
+/// Where a stage policy's episodes run, and how their ends are judged.
+pub struct StageSetup {
+    pub stage: EnvKind,
+    /// The policy's files (prefix of NAME.safetensors and NAME.json).
+    pub prefix: PathBuf,
+    rot_mode: RotMode,
+    /// The object the episodes run on, and the one the policy was trained on.
+    pub object: ObjectKind,
+    pub trained_object: ObjectKind,
+    pub scene: Arc<Scene>,
+    /// The rate the policy acts at, and the one it was trained at.
+    pub control_rate: ControlRate,
+    pub trained_rate: ControlRate,
+    /// The paper's success test: position (Stage 1) and angle thresholds.
+    pub thresholds: (f64, f64),
+}
+
+impl StageSetup {
+    /// The set-up for `stage`'s policy among `files`, on `object` and at `control_rate` where
+    /// given, else on the object and at the rate it was trained at.
+    pub fn new(
+        stage: EnvKind,
+        files: &PolicyFiles,
+        object: Option<ObjectKind>,
+        control_rate: Option<ControlRate>,
+    ) -> anyhow::Result<StageSetup> {
+        let prefix = match stage {
+            EnvKind::Rot => files.rot.clone(),
+            EnvKind::Layer => files.layer.clone(),
+        };
+        let rot_goal = RotGoal::paper(files.rot_mode);
+        let thresholds = match stage {
+            EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
+            EnvKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
+        };
+        let trained_object = trained_on(&prefix, stage)?;
+        let trained_rate = {
+            let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
+            trained_control_rate(&policy, &prefix)?
+        };
+        let object = match object {
+            Some(object) => suited(stage, object)?,
+            None => trained_object,
+        };
+        Ok(StageSetup {
+            stage,
+            rot_mode: files.rot_mode,
+            object,
+            trained_object,
+            scene: Scene::load(object.scene())?,
+            control_rate: control_rate.unwrap_or(trained_rate),
+            trained_rate,
+            thresholds,
+            prefix,
+        })
+    }
+
+    /// The environment `policy` (loaded from `self.prefix`) acts in: its stage's, with the
+    /// goal and view its card names, beginning from `starts` where given.
+    pub fn env(
+        &self,
+        policy: &Policy,
+        starts: Option<StartMix>,
+    ) -> anyhow::Result<Box<dyn SimulatedEnv>> {
+        let prefix = &self.prefix;
+        let view = match self.stage {
+            EnvKind::Rot => PolicyStage1::trained_view(policy, prefix)?,
+            EnvKind::Layer => PolicyStage2::trained_view(policy, prefix)?,
+        };
+        if let Some(seen) = view.name()
+            && self.object != ObjectKind::Cube
+        {
+            bail!(
+                "{} was trained seeing the {seen}, a view of the physical cube: run it with \
+                 --object cube",
+                prefix.display()
+            );
+        }
+        Ok(match self.stage {
+            EnvKind::Rot => {
+                let goal = PolicyStage1::trained_goal(policy, self.rot_mode, prefix)?;
+                let env = CubeRotEnv::with_scene(self.scene.clone(), goal)
+                    .with_view(view)
+                    .with_control_rate(self.control_rate);
+                Box::new(env.with_starts(starts))
+            }
+            EnvKind::Layer => {
+                let env = LayerOpEnv::with_scene(
+                    self.scene.clone(),
+                    LayerMove::UPrime,
+                    LayerGoals::Evaluation,
+                )
+                .with_goal(PolicyStage2::trained_goal(policy, prefix)?)
+                .with_view(view)
+                .with_control_rate(self.control_rate);
+                Box::new(env.with_starts(starts))
+            }
+        })
+    }
+}
+
+/// Whether a step met the paper's test, position and angle within `thresholds`, with the
+/// object on the palm. A policy trained on a stricter test (Stage 2 left square) is still
+/// judged by the paper's here; the good state is counted beside it.
+pub fn meets_paper_test(info: &Info, (position, angle): (f64, f64)) -> bool {
+    !info.dropped
+        && info.physics_error.is_none()
+        && info.position_error < position
+        && info.angle_error < angle
+}
+
+/// The object a policy was trained on, from its card (cards from before the object was an
+/// option were trained on the rigid cube for Stage 1 and on the block for Stage 2).
+fn trained_on(policy: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
+    let path = policy.with_extension("json");
+    let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
+        .with_context(|| format!("reading {}", path.display()))?;
+    let object = match card["metadata"]["environment"]["object"].as_str() {
+        Some(name) => name
+            .parse()
+            .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))?,
+        None => original_object(env),
+    };
+    suited(env, object)
+}
