@@ -21,12 +21,12 @@ use crate::stage::{StageSetup, meets_paper_test};
 
 #[derive(Args)]
 pub struct DistilArgs {
-    /// rot: Stage 1 (CubeRotEnv); layer: Stage 2 (LayerOpEnv U'), each on the object and at the
-    /// rate its policy was trained at.
+    /// rot: Stage 1 (CubeRotEnv with the paper's three targets); layer: Stage 2 (LayerOpEnv U'
+    /// with the goal exactly +90°): the episodes `eval-stage` runs, each on the object and at
+    /// the rate the policy was trained at. The teacher is that stage's policy below, an
+    /// ensemble typically; the student starts as its first member.
     #[arg(value_enum)]
     stage: EnvKind,
-    /// The teacher is the stage's policy here, an ensemble typically. The student starts as
-    /// its first member.
     #[command(flatten)]
     policies: PolicyArgs,
     /// Where to write the student (PATH.safetensors and PATH.json, rewritten after every
