@@ -9,13 +9,13 @@ use std::sync::Mutex;
 use anyhow::bail;
 use burn::prelude::Device;
 use clap::Args;
-use dexcube_env::SimulatedEnv;
+use dexcube_env::{SimulatedEnv, StartMix, StartPick};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_rl::distil::{Demonstrations, DistilConfig, fit};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::env::EnvKind;
+use crate::env::{EnvKind, starts_for};
 use crate::eval::{PolicyArgs, in_parallel};
 use crate::stage::{StageSetup, meets_paper_test};
 
@@ -43,12 +43,30 @@ pub struct DistilArgs {
     /// Passes over all the labels gathered so far, after each round.
     #[arg(long, default_value_t = DistilConfig::default().epochs)]
     epochs: usize,
-    /// Episode k of round r is a fresh placement seeded seed + r * episodes + k; round r's fit
-    /// shuffles with seed + r. The default is a range no evaluation uses.
+    /// Also begin episodes from these recorded starts (made by `eval --record-starts` for rot,
+    /// `eval --record-layer-starts` for layer): where the operator hands the stage the cube,
+    /// which fresh placements do not reach. Each episode begins from one with probability
+    /// --start-share, drawn alike.
+    #[arg(long, value_name = "FILE")]
+    starts: Option<PathBuf>,
+    /// The share of episodes that begin from --starts.
+    #[arg(long, default_value_t = 0.5, requires = "starts", value_parser = share)]
+    start_share: f64,
+    /// Episode k of round r is reset with seed seed + r * episodes + k (a fresh placement, or a
+    /// recorded start drawn by that seed); round r's fit shuffles with seed + r. The default
+    /// is a range no evaluation uses.
     #[arg(long, default_value_t = 5_000_000)]
     seed: u64,
     #[arg(long, default_value_t = 2)]
     threads: usize,
+}
+
+/// A share of episodes: a number from 0 to 1.
+fn share(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
+        _ => Err(format!("a share is a number from 0 to 1, not '{text}'")),
+    }
 }
 
 /// What one round gathered and fitted.
@@ -76,7 +94,17 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
     let files = args.policies.files()?;
     let setup = StageSetup::new(args.stage, &files, None, None)?;
     let teacher = Policy::load(&setup.prefix, &Device::flex())?;
-    let command = format!(
+    let starts = match &args.starts {
+        None => None,
+        Some(path) => Some(StartMix {
+            starts: starts_for(path, &setup.scene, args.stage)?.0,
+            pick: StartPick::Share {
+                share: args.start_share,
+                failed_weight: 1.0,
+            },
+        }),
+    };
+    let mut command = format!(
         "dexcube distil {stage} --{stage}-policy {} --out {} --rounds {} --episodes {} \
          --epochs {} --seed {}",
         setup.prefix.display(),
@@ -87,6 +115,13 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
         args.seed,
         stage = args.stage.name(),
     );
+    if let Some(path) = &args.starts {
+        command += &format!(
+            " --starts {} --start-share {}",
+            path.display(),
+            args.start_share
+        );
+    }
     let head = &teacher.card.metadata;
     let label = head["label"].as_str().unwrap_or("an unlabelled policy");
     let metadata = |rounds: &[Round]| {
@@ -94,6 +129,8 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
             "label": format!("distilled from {label}"),
             "environment": head["environment"],
             "distilled_from": setup.prefix,
+            "starts": args.starts,
+            "start_share": args.starts.as_ref().map(|_| args.start_share),
             "teacher_members": head.get("ensemble"),
             "command": command,
             "distillation": {
@@ -130,7 +167,7 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
                 let device = Device::flex();
                 let teacher = Policy::load(&setup.prefix, &device)?;
                 let student = Policy::load(&args.out, &device)?;
-                let env = setup.env(&teacher, None)?;
+                let env = setup.env(&teacher, starts.clone())?;
                 Ok((teacher, student, env))
             },
             |(teacher, student, env), k| {
