@@ -1080,4 +1080,61 @@ fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
     assert_clean_failure(&distil("0", rot), 2, "--rounds, --episodes and --epochs");
     let missing = dir.join("missing");
     assert_clean_failure(&distil("1", missing.to_str().unwrap()), 2, "missing.json");
+
+    // Episodes may begin where the operator handed Stage 1 the cube; the card says so. A file
+    // of the other stage's starts, or a share that is not one, is refused.
+    let starts = |name: &str| {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../results/starts")
+            .join(name)
+            .to_str()
+            .unwrap()
+            .to_string()
+    };
+    let from = |file: &str, share: &str| {
+        dexcube(
+            &[
+                "distil",
+                "rot",
+                "--rot-policy",
+                rot,
+                "--layer-policy",
+                layer,
+                "--out",
+                out,
+                "--rounds",
+                "1",
+                "--episodes",
+                "2",
+                "--epochs",
+                "1",
+                "--threads",
+                "1",
+                "--starts",
+                file,
+                "--start-share",
+                share,
+            ],
+            "",
+        )
+    };
+    let o = from(&starts("starts-ens-train-seed1.safetensors"), "1");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{out}.json")).unwrap()).unwrap();
+    assert_eq!(card["metadata"]["start_share"], 1.0);
+    assert!(
+        card["metadata"]["command"]
+            .as_str()
+            .unwrap()
+            .contains("--starts ")
+    );
+    let layer_starts = starts("layer-starts-ens-train-seed1.safetensors");
+    assert_clean_failure(
+        &from(&layer_starts, "0.5"),
+        2,
+        "holds layer starts, not rot's",
+    );
+    let o = from(&starts("starts-ens-train-seed1.safetensors"), "2");
+    assert_clean_failure(&o, 2, "a share is a number from 0 to 1");
 }
