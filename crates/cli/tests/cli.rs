@@ -1016,30 +1016,28 @@ fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
     let (rot, layer) = (rot.to_str().unwrap(), layer.to_str().unwrap());
     let out = dir.join("student");
     let out = out.to_str().unwrap();
-    let distil = |rounds: &str, teacher: &str| {
-        dexcube(
-            &[
-                "distil",
-                "rot",
-                "--rot-policy",
-                teacher,
-                "--layer-policy",
-                layer,
-                "--out",
-                out,
-                "--rounds",
-                rounds,
-                "--episodes",
-                "2",
-                "--epochs",
-                "1",
-                "--threads",
-                "1",
-            ],
-            "",
-        )
+    let distil = |rounds: &str, teacher: &str, more: &[&str]| {
+        let common = [
+            "distil",
+            "rot",
+            "--rot-policy",
+            teacher,
+            "--layer-policy",
+            layer,
+            "--out",
+            out,
+            "--rounds",
+            rounds,
+            "--episodes",
+            "2",
+            "--epochs",
+            "1",
+            "--threads",
+            "1",
+        ];
+        dexcube(&[&common[..], more].concat(), "")
     };
-    let o = distil("2", rot);
+    let o = distil("2", rot, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let card: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(format!("{out}.json")).unwrap()).unwrap();
@@ -1077,9 +1075,17 @@ fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("/2 ="), "{}", stdout(&o));
 
-    assert_clean_failure(&distil("0", rot), 2, "--rounds, --episodes and --epochs");
+    assert_clean_failure(
+        &distil("0", rot, &[]),
+        2,
+        "--rounds, --episodes and --epochs",
+    );
     let missing = dir.join("missing");
-    assert_clean_failure(&distil("1", missing.to_str().unwrap()), 2, "missing.json");
+    assert_clean_failure(
+        &distil("1", missing.to_str().unwrap(), &[]),
+        2,
+        "missing.json",
+    );
 
     // Episodes may begin where the operator handed Stage 1 the cube; the card says so. A file
     // of the other stage's starts, or a share that is not one, is refused.
@@ -1091,33 +1097,8 @@ fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
             .unwrap()
             .to_string()
     };
-    let from = |file: &str, share: &str| {
-        dexcube(
-            &[
-                "distil",
-                "rot",
-                "--rot-policy",
-                rot,
-                "--layer-policy",
-                layer,
-                "--out",
-                out,
-                "--rounds",
-                "1",
-                "--episodes",
-                "2",
-                "--epochs",
-                "1",
-                "--threads",
-                "1",
-                "--starts",
-                file,
-                "--start-share",
-                share,
-            ],
-            "",
-        )
-    };
+    let from =
+        |file: &str, share: &str| distil("1", rot, &["--starts", file, "--start-share", share]);
     let o = from(&starts("starts-ens-train-seed1.safetensors"), "1");
     assert!(o.status.success(), "{}", stderr(&o));
     let card: serde_json::Value =
