@@ -93,6 +93,17 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
     }
     let files = args.policies.files()?;
     let setup = StageSetup::new(args.stage, &files, None, None)?;
+    let same_file = |a: &std::path::Path, b: &std::path::Path| {
+        let card = |p: &std::path::Path| p.with_extension("json").canonicalize().ok();
+        a == b || card(a).is_some_and(|a| Some(a) == card(b))
+    };
+    if same_file(&args.out, &setup.prefix) {
+        bail!(
+            "--out {} is the teacher itself, which the rounds read again: write the student \
+             elsewhere",
+            args.out.display()
+        );
+    }
     let teacher = Policy::load(&setup.prefix, &Device::flex())?;
     let starts = match &args.starts {
         None => None,

@@ -1080,6 +1080,18 @@ fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
         2,
         "--rounds, --episodes and --epochs",
     );
+    let teacher_copy = copy_policy("rot", &dir, "teacher");
+    let teacher_copy = teacher_copy.to_str().unwrap();
+    let over_itself = [
+        "--rot-policy",
+        teacher_copy,
+        "--layer-policy",
+        layer,
+        "--out",
+        teacher_copy,
+    ];
+    let o = dexcube(&[&["distil", "rot"][..], &over_itself].concat(), "");
+    assert_clean_failure(&o, 2, "is the teacher itself");
     let missing = dir.join("missing");
     assert_clean_failure(
         &distil("1", missing.to_str().unwrap(), &[]),
