@@ -204,8 +204,7 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
             .into_iter()
             .for_each(|(_, shown, _)| demonstrations.extend(shown));
         let error_before_fit = demonstrations.mean_squared_error(&student);
-        student = fit(&student, &demonstrations, config, args.seed + round as u64)
-            .map_err(|e| anyhow::anyhow!("fitting the student: {e}"))?;
+        student = fit(&student, &demonstrations, config, args.seed + round as u64)?;
         rounds.push(Round {
             round,
             acting: if teacher_acts { "teacher" } else { "student" },

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
     ControlRate, CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode,
@@ -53,11 +53,9 @@ impl StageSetup {
             EnvKind::Rot => (rot_goal.position_threshold, rot_goal.angle_threshold),
             EnvKind::Layer => (f64::INFINITY, LayerGoal::default().angle_threshold),
         };
-        let trained_object = trained_on(&prefix, stage)?;
-        let trained_rate = {
-            let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
-            trained_control_rate(&policy, &prefix)?
-        };
+        let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
+        let trained_object = trained_on(&policy, &prefix, stage)?;
+        let trained_rate = trained_control_rate(&policy, &prefix)?;
         let object = match object {
             Some(object) => suited(stage, object)?,
             None => trained_object,
@@ -129,16 +127,14 @@ pub fn meets_paper_test(info: &Info, (position, angle): (f64, f64)) -> bool {
         && info.angle_error < angle
 }
 
-/// The object a policy was trained on, from its card (cards from before the object was an
-/// option were trained on the rigid cube for Stage 1 and on the block for Stage 2).
-fn trained_on(policy: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
-    let path = policy.with_extension("json");
-    let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
-        .with_context(|| format!("reading {}", path.display()))?;
-    let object = match card["metadata"]["environment"]["object"].as_str() {
-        Some(name) => name
-            .parse()
-            .map_err(|e: String| anyhow::anyhow!("{}: {e}", path.display()))?,
+/// The object a policy (loaded from `prefix`) was trained on, from its card (cards from before
+/// the object was an option were trained on the rigid cube for Stage 1 and on the block for
+/// Stage 2).
+fn trained_on(policy: &Policy, prefix: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
+    let object = match policy.card.metadata["environment"]["object"].as_str() {
+        Some(name) => name.parse().map_err(|e: String| {
+            anyhow::anyhow!("{}: {e}", prefix.with_extension("json").display())
+        })?,
         None => original_object(env),
     };
     suited(env, object)

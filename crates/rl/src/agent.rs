@@ -472,8 +472,24 @@ pub fn network_inputs(
     let (dobs, dgoal) = (observation_norm.size(), goal_norm.size());
     let mut x = Vec::with_capacity(n * (dobs + dgoal));
     for i in 0..n {
-        observation_norm.normalize_into(&observation[i * dobs..(i + 1) * dobs], &mut x);
-        goal_norm.normalize_into(&goal[i * dgoal..(i + 1) * dgoal], &mut x);
+        input_row_into(
+            (observation_norm, goal_norm),
+            &observation[i * dobs..(i + 1) * dobs],
+            &goal[i * dgoal..(i + 1) * dgoal],
+            &mut x,
+        );
     }
     Tensor::from_data(TensorData::new(x, [n, dobs + dgoal]), device)
+}
+
+/// One row of network inputs appended to `out`: the leading part of `observation` that the
+/// observation normaliser takes, and the goal, each normalised.
+pub(crate) fn input_row_into(
+    (observation_norm, goal_norm): (&Normalizer, &Normalizer),
+    observation: &[f64],
+    goal: &[f64],
+    out: &mut Vec<f32>,
+) {
+    observation_norm.normalize_into(&observation[..observation_norm.size()], out);
+    goal_norm.normalize_into(&goal[..goal_norm.size()], out);
 }

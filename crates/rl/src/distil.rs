@@ -18,7 +18,7 @@ use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::agent::scalar;
+use crate::agent::{input_row_into, scalar};
 use crate::networks::Mlp;
 use crate::params::{self, ParamMismatch};
 use crate::policy::Policy;
@@ -64,9 +64,12 @@ impl Demonstrations {
         goal: &[f64],
     ) -> Vec<f64> {
         let card = &student.card;
-        card.observation_norm
-            .normalize_into(&observation[..card.dims.observation], &mut self.inputs);
-        card.goal_norm.normalize_into(goal, &mut self.inputs);
+        input_row_into(
+            (&card.observation_norm, &card.goal_norm),
+            observation,
+            goal,
+            &mut self.inputs,
+        );
         let action = teacher.act(observation, goal);
         self.actions.extend(action.iter().map(|&a| a as f32));
         self.rows += 1;

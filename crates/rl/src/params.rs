@@ -126,6 +126,8 @@ impl std::fmt::Display for ParamMismatch {
     }
 }
 
+impl std::error::Error for ParamMismatch {}
+
 /// `module` with each parameter replaced by `blend(current, given)`, where `given` is the
 /// tensor of the same name in `values`. The results are detached from any autodiff graph.
 pub fn write<M: Module>(
