@@ -162,6 +162,9 @@ pub struct HandObject {
     /// How often a policy acts: the paper's rate unless set. Placing and settling keep the
     /// paper's, so every rate starts from the same placements.
     pub rate: ControlRate,
+    /// The most an actuator's target may move in one control step, in action units (the
+    /// action range is 2 wide); `None` (the paper's) lets it jump anywhere at once.
+    pub action_slew: Option<f64>,
 }
 
 impl HandObject {
@@ -182,6 +185,7 @@ impl HandObject {
             resting,
             steps: 0,
             rate: ControlRate::PAPER,
+            action_slew: None,
         }
     }
 
@@ -223,12 +227,16 @@ impl HandObject {
     /// reset, and the episode must end).
     fn advance(&mut self, action: &[f64]) -> Option<dexcube_sim::SimError> {
         let mut clipped = [0.0; HAND_ACTUATORS];
-        for (c, a) in clipped.iter_mut().zip(action) {
+        let held = self.sim.action();
+        for ((c, a), held) in clipped.iter_mut().zip(action).zip(held) {
             *c = if a.is_finite() {
                 a.clamp(-1.0, 1.0)
             } else {
                 0.0
             };
+            if let Some(slew) = self.action_slew {
+                *c = c.clamp(held - slew, held + slew);
+            }
         }
         self.sim.set_action(&clipped);
         self.steps += 1;

@@ -386,6 +386,13 @@ impl LayerOpEnv {
         self
     }
 
+    /// The same environment with each actuator's target moving at most `slew` action units
+    /// per control step ([`HandObject::action_slew`]).
+    pub fn with_action_slew(mut self, slew: Option<f64>) -> LayerOpEnv {
+        self.hand.action_slew = slew;
+        self
+    }
+
     /// The same environment judged by `goal`, e.g. [`LayerGoal::square`] to also need the
     /// cube left in its good state.
     pub fn with_goal(mut self, goal: LayerGoal) -> LayerOpEnv {

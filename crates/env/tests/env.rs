@@ -764,3 +764,39 @@ fn a_faster_control_rate_keeps_the_episode_four_seconds_long() {
         assert!(ControlRate::every(refused).is_err(), "{refused}");
     }
 }
+
+/// A slew limit moves each actuator's target at most that far per control step, towards the
+/// action asked for, and reaches it in as many steps as the distance needs; without one the
+/// target jumps at once.
+#[test]
+fn a_slew_limit_moves_each_target_at_most_that_far_per_step() {
+    let scene = Scene::load(dexcube_sim::SceneKind::Cube).unwrap();
+    let env = |slew| {
+        let mut env =
+            LayerOpEnv::with_scene(scene.clone(), LayerMove::UPrime, LayerGoals::Evaluation)
+                .with_action_slew(slew);
+        env.reset(Some(5));
+        env
+    };
+    let (mut free, mut slewed) = (env(None), env(Some(0.3)));
+    let held = slewed.sim().action();
+    let asked: Vec<f64> = held
+        .iter()
+        .map(|h| if *h > 0.0 { -1.0 } else { 1.0 })
+        .collect();
+    let close = |a: [f64; 20]| a.iter().zip(&asked).all(|(x, y)| (x - y).abs() < 1e-9);
+    free.step(&asked);
+    assert!(close(free.sim().action()), "no limit: the target jumps");
+    for step in 1..=7 {
+        slewed.step(&asked);
+        for (i, (now, target)) in slewed.sim().action().iter().zip(&asked).enumerate() {
+            let expected =
+                held[i] + (target - held[i]).clamp(-0.3 * step as f64, 0.3 * step as f64);
+            assert!(
+                (now - expected).abs() < 1e-9,
+                "step {step}, actuator {i}: {now} against {expected}"
+            );
+        }
+    }
+    assert!(close(slewed.sim().action()), "reached within 2 / 0.3 steps");
+}

@@ -1,0 +1,188 @@
+//! How Stage 2 moves when it jams, and where it stands once jammed. Runs a Stage 2 policy
+//! from fresh placements (episode i reset with seed + i, as `dexcube eval-stage` does) or
+//! from the failed starts of a recording, and sorts the episodes by how they ended: success;
+//! a jam (the layer never turned, the cube left out of its good state); any other miss. For
+//! each kind it prints how much the fingers' targets changed per step, over the first steps
+//! and after them.
+//!
+//! `--slew S` caps each actuator's target change per control step
+//! ([`LayerOpEnv::with_action_slew`]), to ask whether gentler fingers jam less. `--keep-jams
+//! OUT` writes, for every jammed episode, the physics state at steps 10, 30 and 60 as Stage 2
+//! starts (the quarter turn asked for, counted from the angle the layer had turned, marked
+//! failed), so that a run can train from inside a jam (`dexcube train layer --starts OUT`).
+//!
+//! `cargo run --release -p dexcube-operator --example stage2_jam_onset -- POLICY
+//! (--fresh SEED EPISODES | --failed-starts FILE) [--slew S] [--keep-jams OUT]`
+
+use std::f64::consts::FRAC_PI_2;
+use std::path::{Path, PathBuf};
+
+use dexcube_env::layer::LayerGoals;
+use dexcube_env::{GoalEnv, LayerMove, LayerOpEnv, RecordedFailure, RecordedStart, SimulatedEnv};
+use dexcube_operator::stages::PolicyStage2;
+use dexcube_rl::Policy;
+use dexcube_rl::start_file::{StartsOrigin, load_starts, save_starts};
+use dexcube_sim::{Scene, SceneKind};
+
+/// The good state's bound on a cubelet's angle off a quarter turn, radians.
+const GOOD_STATE: f64 = 0.1;
+/// A layer more than this short of the quarter turn never turned (67.5 degrees, as
+/// `eval-stage` counts).
+const NEVER_TURNED: f64 = 3.0 * std::f64::consts::FRAC_PI_8;
+/// The first steps, where session 3 saw the side layers give way.
+const EARLY_STEPS: usize = 5;
+/// The steps of a jammed episode whose states `--keep-jams` writes.
+const KEPT_STEPS: [usize; 3] = [10, 30, 60];
+
+/// The episodes of one ending, and their mean action change per step and actuator.
+#[derive(Default)]
+struct Tally {
+    episodes: usize,
+    early_change: f64,
+    late_change: f64,
+}
+
+impl Tally {
+    fn line(&self, name: &str) -> String {
+        let n = self.episodes.max(1) as f64;
+        format!(
+            "{name}: {} episodes; mean |action change| per step and actuator {:.3} over the \
+             first {EARLY_STEPS} steps, {:.3} after",
+            self.episodes,
+            self.early_change / n,
+            self.late_change / n,
+        )
+    }
+}
+
+/// Where the episodes begin.
+enum Starts {
+    Fresh { seed: u64, episodes: u64 },
+    Failed(Vec<RecordedStart>),
+}
+
+struct Args {
+    policy: PathBuf,
+    starts: Starts,
+    slew: Option<f64>,
+    keep_jams: Option<PathBuf>,
+}
+
+fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
+    let usage = "usage: stage2_jam_onset POLICY (--fresh SEED EPISODES | --failed-starts FILE) \
+                 [--slew S] [--keep-jams OUT]";
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let policy = PathBuf::from(args.first().ok_or(usage)?);
+    let (mut starts, mut slew, mut keep_jams) = (None, None, None);
+    let mut rest = args[1..].iter();
+    while let Some(flag) = rest.next() {
+        let mut value = || rest.next().ok_or(usage);
+        match flag.as_str() {
+            "--fresh" => {
+                let (seed, episodes) = (value()?.parse()?, value()?.parse()?);
+                starts = Some(Starts::Fresh { seed, episodes });
+            }
+            "--failed-starts" => {
+                let (recorded, _) = load_starts(Path::new(value()?))?;
+                starts = Some(Starts::Failed(
+                    recorded.into_iter().filter(|s| s.failed).collect(),
+                ));
+            }
+            "--slew" => slew = Some(value()?.parse()?),
+            "--keep-jams" => keep_jams = Some(PathBuf::from(value()?)),
+            _ => return Err(usage.into()),
+        }
+    }
+    Ok(Args {
+        policy,
+        starts: starts.ok_or(usage)?,
+        slew,
+        keep_jams,
+    })
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args = parse_args()?;
+    let policy = Policy::load(&args.policy, &burn::prelude::Device::flex())?;
+    let mut env = LayerOpEnv::with_scene(
+        Scene::load(SceneKind::Cube)?,
+        LayerMove::UPrime,
+        LayerGoals::Evaluation,
+    )
+    .with_goal(PolicyStage2::trained_goal(&policy, &args.policy)?)
+    .with_view(PolicyStage2::trained_view(&policy, &args.policy)?)
+    .with_action_slew(args.slew);
+    let episodes = match &args.starts {
+        Starts::Fresh { episodes, .. } => *episodes as usize,
+        Starts::Failed(starts) => starts.len(),
+    };
+    let [mut succeeded, mut jammed, mut other] = [(); 3].map(|_| Tally::default());
+    let mut jam_states = Vec::new();
+    for episode in 0..episodes {
+        let (mut observation, _) = match &args.starts {
+            Starts::Fresh { seed, .. } => env.reset(Some(seed + episode as u64)),
+            Starts::Failed(starts) => env.reset_from(&starts[episode])?,
+        };
+        let (mut changes, mut kept) = (Vec::new(), Vec::new());
+        let mut previous: Option<Vec<f64>> = None;
+        let mut step = 0;
+        let info = loop {
+            if KEPT_STEPS.contains(&step) {
+                kept.push(RecordedStart {
+                    state: env.sim().physics_state(),
+                    goal: vec![FRAC_PI_2, observation.achieved_goal[0]],
+                    failed: true,
+                });
+            }
+            let action = policy.act(&observation.observation, &observation.desired_goal);
+            if let Some(before) = &previous {
+                let moved: f64 = action.iter().zip(before).map(|(a, b)| (a - b).abs()).sum();
+                changes.push(moved / action.len() as f64);
+            }
+            let transition = env.step(&action);
+            step += 1;
+            previous = Some(action);
+            observation = transition.observation;
+            if transition.terminated || transition.truncated {
+                break transition.info;
+            }
+        };
+        let skewed = observation.achieved_goal[1] > GOOD_STATE;
+        let tally = if info.is_success {
+            &mut succeeded
+        } else if skewed && !info.dropped && info.angle_error > NEVER_TURNED {
+            jam_states.extend(kept);
+            &mut jammed
+        } else {
+            &mut other
+        };
+        let mean = |steps: &[f64]| steps.iter().sum::<f64>() / steps.len().max(1) as f64;
+        let early = changes.len().min(EARLY_STEPS - 1);
+        tally.episodes += 1;
+        tally.early_change += mean(&changes[..early]);
+        tally.late_change += mean(&changes[early..]);
+    }
+    println!(
+        "policy {}, slew limit {:?}",
+        args.policy.display(),
+        args.slew
+    );
+    println!("{}", succeeded.line("succeeded"));
+    println!("{}", jammed.line("jammed (never turned, left skewed)"));
+    println!("{}", other.line("missed otherwise"));
+    if let Some(out) = &args.keep_jams {
+        let origin = StartsOrigin {
+            stage: "layer".into(),
+            failure: RecordedFailure::NotSquare,
+            scene: "cube".into(),
+            command: std::env::args().collect::<Vec<_>>().join(" "),
+        };
+        save_starts(out, &jam_states, &origin)?;
+        println!(
+            "kept {} states from inside jams in {}",
+            jam_states.len(),
+            out.display()
+        );
+    }
+    Ok(())
+}
