@@ -227,14 +227,15 @@ impl HandObject {
     /// reset, and the episode must end).
     fn advance(&mut self, action: &[f64]) -> Option<dexcube_sim::SimError> {
         let mut clipped = [0.0; HAND_ACTUATORS];
-        let held = self.sim.action();
-        for ((c, a), held) in clipped.iter_mut().zip(action).zip(held) {
+        for (c, a) in clipped.iter_mut().zip(action) {
             *c = if a.is_finite() {
                 a.clamp(-1.0, 1.0)
             } else {
                 0.0
             };
-            if let Some(slew) = self.action_slew {
+        }
+        if let Some(slew) = self.action_slew {
+            for (c, held) in clipped.iter_mut().zip(self.sim.action()) {
                 *c = c.clamp(held - slew, held + slew);
             }
         }

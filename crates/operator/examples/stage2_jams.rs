@@ -11,7 +11,7 @@
 //! starts (the quarter turn asked for, counted from the angle the layer had turned, marked
 //! failed), so that a run can train from inside a jam (`dexcube train layer --starts OUT`).
 //!
-//! `cargo run --release -p dexcube-operator --example stage2_jam_onset -- POLICY
+//! `cargo run --release -p dexcube-operator --example stage2_jams -- POLICY
 //! (--fresh SEED EPISODES | --failed-starts FILE) [--slew S] [--keep-jams OUT]`
 
 use std::f64::consts::FRAC_PI_2;
@@ -69,7 +69,7 @@ struct Args {
 }
 
 fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
-    let usage = "usage: stage2_jam_onset POLICY (--fresh SEED EPISODES | --failed-starts FILE) \
+    let usage = "usage: stage2_jams POLICY (--fresh SEED EPISODES | --failed-starts FILE) \
                  [--slew S] [--keep-jams OUT]";
     let args: Vec<String> = std::env::args().skip(1).collect();
     let policy = PathBuf::from(args.first().ok_or(usage)?);
