@@ -18,14 +18,14 @@ use std::f64::consts::FRAC_PI_2;
 use std::path::{Path, PathBuf};
 
 use dexcube_env::layer::LayerGoals;
-use dexcube_env::{GoalEnv, LayerMove, LayerOpEnv, RecordedFailure, RecordedStart, SimulatedEnv};
+use dexcube_env::{
+    GoalEnv, LayerMove, LayerOpEnv, RecordedFailure, RecordedStart, SimulatedEnv, is_square,
+};
 use dexcube_operator::stages::PolicyStage2;
 use dexcube_rl::Policy;
 use dexcube_rl::start_file::{StartsOrigin, load_starts, save_starts};
 use dexcube_sim::{Scene, SceneKind};
 
-/// The good state's bound on a cubelet's angle off a quarter turn, radians.
-const GOOD_STATE: f64 = 0.1;
 /// A layer more than this short of the quarter turn never turned (67.5 degrees, as
 /// `eval-stage` counts).
 const NEVER_TURNED: f64 = 3.0 * std::f64::consts::FRAC_PI_8;
@@ -116,7 +116,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Starts::Fresh { episodes, .. } => *episodes as usize,
         Starts::Failed(starts) => starts.len(),
     };
-    let [mut succeeded, mut jammed, mut other] = [(); 3].map(|_| Tally::default());
+    let [mut succeeded, mut jammed, mut other]: [Tally; 3] = Default::default();
     let mut jam_states = Vec::new();
     for episode in 0..episodes {
         let (mut observation, _) = match &args.starts {
@@ -147,10 +147,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 break transition.info;
             }
         };
-        let skewed = observation.achieved_goal[1] > GOOD_STATE;
         let tally = if info.is_success {
             &mut succeeded
-        } else if skewed && !info.dropped && info.angle_error > NEVER_TURNED {
+        } else if !is_square(env.sim()) && !info.dropped && info.angle_error > NEVER_TURNED {
             jam_states.extend(kept);
             &mut jammed
         } else {
