@@ -42,6 +42,10 @@ enum Command {
     /// actions. The first gives the card (label, environment, view) and must observe at least
     /// as much as the others, which read the leading part of its observation.
     Ensemble(train::CombineArgs),
+    /// Lets a training run's critics choose the action a policy takes: of its own action and
+    /// a few near it, the one they value most (the smaller of TD3's two values). Writes a
+    /// policy that loads and runs as any other.
+    Guide(train::GuideArgs),
     /// Teaches one actor to act as a stage policy does (an ensemble, typically) by DAgger:
     /// the teacher labels every state of episodes run first by itself, then by the student.
     Distil(distil::DistilArgs),
@@ -74,6 +78,7 @@ fn main() -> ExitCode {
         Command::Plot(args) => train::plot(args),
         Command::Average(args) => train::combine(train::Combination::Average, args),
         Command::Ensemble(args) => train::combine(train::Combination::Ensemble, args),
+        Command::Guide(args) => train::guide(args),
         Command::Distil(args) => distil::run(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),

@@ -203,6 +203,51 @@ pub fn combine(how: Combination, args: CombineArgs) -> anyhow::Result<ExitCode> 
     Ok(ExitCode::SUCCESS)
 }
 
+#[derive(Args)]
+pub struct GuideArgs {
+    /// The policy to guide (a single one or an ensemble), as the path of its .safetensors and
+    /// .json less the extension.
+    policy: PathBuf,
+    /// The training run whose critics choose (its folder, with checkpoint/): the policy's
+    /// own, or one trained on the same observations, goals and actions.
+    #[arg(long, value_name = "RUN")]
+    critics: PathBuf,
+    /// How many actions beside the policy's own the critics weigh at each step.
+    #[arg(long, default_value_t = 32, value_name = "K")]
+    candidates: usize,
+    /// How far each candidate lies from the policy's action: this times a standard normal
+    /// direction per actuator (the action range is 2 wide).
+    #[arg(long, default_value_t = 0.1, value_name = "S")]
+    spread: f64,
+    /// The seed the candidates' directions are drawn from, once.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Where to write the result (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn guide(args: GuideArgs) -> anyhow::Result<ExitCode> {
+    let command = format!(
+        "dexcube guide {} --critics {} --candidates {} --spread {} --seed {} --out {}",
+        args.policy.display(),
+        args.critics.display(),
+        args.candidates,
+        args.spread,
+        args.seed,
+        args.out.display()
+    );
+    let choice = (args.candidates, args.spread, args.seed);
+    Policy::guide(&args.policy, &args.critics, choice, &args.out, &command)?;
+    println!(
+        "{} guided by the critics of {} into {}",
+        args.policy.display(),
+        args.critics.display(),
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Refuses to resume a run with other recorded starts, or at another control rate, than it
 /// began with (its checkpoint's card names them), since the card would then say it trained
 /// on starts, or at a rate, it did not.

@@ -12,6 +12,7 @@
 //! - [`start_file`]: recorded Stage 1 starts on disk, to train and evaluate from;
 //! - [`seeds`]: learning curves across seeds, mean ± one standard deviation;
 //! - [`policy`]: a trained actor as shipped, with its normalisers;
+//! - [`guide`]: a run's critics choosing among actions near a policy's own;
 //! - [`distil`]: one actor fitted to act as another policy (an ensemble) does, by DAgger;
 //! - [`point_mass`]: a small reaching task that proves the learner in seconds.
 //!
@@ -22,6 +23,7 @@ pub mod agent;
 pub mod checkpoint;
 pub mod config;
 pub mod distil;
+pub mod guide;
 pub mod networks;
 pub mod normalizer;
 pub mod params;

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::agent::{Agent, Dims, network_inputs};
 use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
+use crate::guide::{self, CriticGuide, GuideCard};
 use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
 use crate::params::{self, NamedTensor};
@@ -31,6 +32,9 @@ pub struct PolicyCard {
     /// The other members of an ensemble; empty for a single policy.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub partners: Vec<PartnerCard>,
+    /// A run's critics choosing among actions near the policy's own; none for the paper's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub guide: Option<GuideCard>,
 }
 
 /// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
@@ -51,6 +55,8 @@ pub struct Policy {
     pub(crate) actor: Mlp,
     /// The partners' actors, in the order of `card.partners`.
     partners: Vec<Mlp>,
+    /// A run's critics choosing among actions near the actor's, when guided.
+    guide: Option<CriticGuide>,
     pub(crate) device: Device,
 }
 
@@ -75,6 +81,16 @@ pub(crate) fn read_single(
     used: &str,
 ) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>), CheckpointError> {
     let (weights, card, tensors) = read_stored(prefix)?;
+    if let Some(guide) = &card.guide {
+        return Err(mismatch(
+            &weights,
+            format!(
+                "it is guided by the critics of {} and cannot be {used}: use the policy it was \
+                 made from (its card's metadata.guided names it)",
+                guide.run.display()
+            ),
+        ));
+    }
     if card.partners.is_empty() {
         return Ok((weights, card, tensors));
     }
@@ -119,6 +135,7 @@ impl Policy {
             goal_norm: agent.goal_norm.clone(),
             metadata,
             partners: Vec::new(),
+            guide: None,
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -258,6 +275,53 @@ impl Policy {
         checkpoint::save_json(&card_path, &card)
     }
 
+    /// Writes at `out` the policy at `policy` (a single one or an ensemble) guided by the
+    /// critics of the training run in `run` ([`CriticGuide`]): `candidates` actions beside its
+    /// own, each `spread` times a standard normal direction drawn from `seed`. The critics must
+    /// take the observations, goals and actions the policy does. The card records the run and
+    /// `command`, the command that guided it.
+    pub fn guide(
+        policy: &Path,
+        run: &Path,
+        (candidates, spread, seed): (usize, f64, u64),
+        out: &Path,
+        command: &str,
+    ) -> Result<(), CheckpointError> {
+        let (weights, card, mut tensors) = read_stored(policy)?;
+        if card.guide.is_some() {
+            return Err(mismatch(
+                &weights,
+                "it is guided already: guide the policy it was made from".to_string(),
+            ));
+        }
+        let (guide, dims, critics) = guide::read_run(run, (candidates, spread, seed))?;
+        if dims != card.dims {
+            return Err(mismatch(
+                run,
+                format!(
+                    "its critics take sizes {dims:?}, the policy {:?}: guide a policy with the \
+                     critics of the run it came from, or of one trained on its observations",
+                    card.dims
+                ),
+            ));
+        }
+        tensors.extend(critics);
+        let label = card.metadata["label"].as_str().unwrap_or("a policy");
+        let card = PolicyCard {
+            metadata: serde_json::json!({
+                "label": format!("{label}, guided by the critics of {}", run.display()),
+                "environment": card.metadata["environment"],
+                "guided": policy,
+                "command": command,
+            }),
+            guide: Some(guide),
+            ..card
+        };
+        let (weights, card_path) = policy_paths(out);
+        checkpoint::save_tensors(&weights, &tensors)?;
+        checkpoint::save_json(&card_path, &card)
+    }
+
     /// Loads the policy at `prefix` onto `device`.
     pub fn load(prefix: &Path, device: &Device) -> Result<Policy, CheckpointError> {
         let (weights, card, tensors) = read_stored(prefix)?;
@@ -286,10 +350,16 @@ impl Policy {
                 build(partner.dims, &partner.hidden, &own)
             })
             .collect::<Result<_, _>>()?;
+        let guide = card
+            .guide
+            .as_ref()
+            .map(|g| CriticGuide::build(g, card.dims, &tensors, &weights, device))
+            .transpose()?;
         Ok(Policy {
             card,
             actor,
             partners,
+            guide,
             device: device.clone(),
         })
     }
@@ -307,20 +377,24 @@ impl Policy {
         Policy {
             card: PolicyCard {
                 partners: Vec::new(),
+                guide: None,
                 ..self.card.clone()
             },
             actor,
             partners: Vec::new(),
+            guide: None,
             device: self.device.clone(),
         }
     }
 
     /// Writes a single policy at `prefix` (`prefix.safetensors` and `prefix.json`).
     pub fn write(&self, prefix: &Path) -> Result<(), CheckpointError> {
-        if !self.partners.is_empty() {
+        if !self.partners.is_empty() || self.guide.is_some() {
             return Err(mismatch(
                 prefix,
-                "an ensemble is written by `Policy::ensemble`, from its members".to_string(),
+                "an ensemble or a guided policy is written by `Policy::ensemble` or \
+                 `Policy::guide`, from what it is made of"
+                    .to_string(),
             ));
         }
         let (weights, card_path) = policy_paths(prefix);
@@ -354,7 +428,10 @@ impl Policy {
         }
         let scale = 1.0 / self.members() as f64;
         total.iter_mut().for_each(|t| *t *= scale);
-        total
+        match &self.guide {
+            Some(guide) => guide.choose(observation, goal, total),
+            None => total,
+        }
     }
 
     /// One actor's action, from the leading part of the observation that its normaliser takes.

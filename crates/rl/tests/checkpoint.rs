@@ -49,6 +49,14 @@ fn first_actions(agent: &Agent, policy: &Policy, episodes: u64) -> Vec<(Vec<f64>
         .collect()
 }
 
+/// The message of loading the policy at `prefix`, which must fail.
+fn load_error(prefix: &std::path::Path) -> String {
+    match Policy::load(prefix, &burn::prelude::Device::flex()) {
+        Ok(_) => panic!("{} loaded", prefix.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
 fn fresh_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(name);
     let _ = std::fs::remove_dir_all(&dir);
@@ -533,15 +541,11 @@ fn a_saved_policy_acts_like_the_agent_it_came_from() {
 fn corrupt_and_mismatched_files_are_clear_errors() {
     let dir = fresh_dir("dexcube-rl-corrupt");
     train(PointMassEnv::default, config(), &options(&dir, 1, false)).unwrap();
-    let device = burn::prelude::Device::flex();
     // Truncate the weights.
     let weights = dir.join("policy.safetensors");
     let bytes = std::fs::read(&weights).unwrap();
     std::fs::write(&weights, &bytes[..bytes.len() / 2]).unwrap();
-    let err = Policy::load(&dir.join("policy"), &device)
-        .err()
-        .unwrap()
-        .to_string();
+    let err = load_error(&dir.join("policy"));
     assert!(
         err.contains("policy.safetensors") && err.contains("not a valid checkpoint"),
         "{err}"
@@ -549,18 +553,12 @@ fn corrupt_and_mismatched_files_are_clear_errors() {
     // Weights of another network under this card.
     let small = small_network_run("dexcube-rl-small");
     std::fs::copy(small.join("policy.safetensors"), &weights).unwrap();
-    let err = Policy::load(&dir.join("policy"), &device)
-        .err()
-        .unwrap()
-        .to_string();
+    let err = load_error(&dir.join("policy"));
     assert!(
         err.contains("does not fit this network") && err.contains("shape"),
         "{err}"
     );
-    let err = Policy::load(&dir.join("nothing"), &device)
-        .err()
-        .unwrap()
-        .to_string();
+    let err = load_error(&dir.join("nothing"));
     assert!(err.contains("nothing.json"), "{err}");
 }
 
@@ -829,4 +827,66 @@ fn a_distilled_student_acts_as_its_ensemble_does() {
     );
     let err = teacher.write(&dir.join("x")).err().unwrap().to_string();
     assert!(err.contains("written by `Policy::ensemble`"), "{err}");
+}
+
+#[test]
+fn a_policy_guided_by_its_run_s_critics_ships_them_and_bad_critics_are_clear_errors() {
+    let dir = fresh_dir("dexcube-rl-guide");
+    train(PointMassEnv::default, config(), &options(&dir, 1, false)).unwrap();
+    let device = burn::prelude::Device::flex();
+    let policy = dir.join("policy");
+    let guided = |candidates: usize, name: &str| {
+        let out = dir.join(name);
+        Policy::guide(&policy, &dir, (candidates, 0.2, 0), &out, "test").unwrap();
+        Policy::load(&out, &device).unwrap()
+    };
+    let plain = Policy::load(&policy, &device).unwrap();
+    let (unmoved, moved) = (guided(0, "unmoved"), guided(32, "moved"));
+    assert_eq!(
+        moved.card.guide.as_ref().unwrap().critics,
+        1,
+        "DDPG: one critic"
+    );
+    let mut env = PointMassEnv::default();
+    let mut differs = false;
+    for seed in 0..5 {
+        let (obs, _) = env.reset(Some(seed));
+        let act = |p: &Policy| p.act(&obs.observation, &obs.desired_goal);
+        assert_eq!(
+            act(&plain),
+            act(&unmoved),
+            "no candidates: the actor's own action"
+        );
+        let chosen = act(&moved);
+        assert!(chosen.iter().all(|a| a.abs() <= 1.0), "{chosen:?}");
+        differs |= chosen != act(&plain);
+    }
+    assert!(
+        differs,
+        "with candidates the critic chose another action somewhere"
+    );
+    let err = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
+        result.err().unwrap().to_string()
+    };
+    // A guided policy is not guided again, nor trained from.
+    let again = Policy::guide(
+        &dir.join("moved"),
+        &dir,
+        (4, 0.2, 0),
+        &dir.join("x"),
+        "test",
+    );
+    assert!(err(again).contains("guided already"));
+    let joined = Policy::ensemble(&[dir.join("moved"), policy.clone()], &dir.join("x"), "test");
+    assert!(err(joined).contains("guided by the critics of"));
+    // The critics of a run of another width under this run's state.
+    let small = small_network_run("dexcube-rl-guide-small");
+    let critic = dir.join("checkpoint").join("critic.safetensors");
+    std::fs::copy(small.join("checkpoint").join("critic.safetensors"), &critic).unwrap();
+    Policy::guide(&policy, &dir, (4, 0.2, 0), &dir.join("bad"), "test").unwrap();
+    let message = load_error(&dir.join("bad"));
+    assert!(
+        message.contains("bad.safetensors") && message.contains("guide's critic 0"),
+        "{message}"
+    );
 }
