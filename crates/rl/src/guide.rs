@@ -69,6 +69,14 @@ pub(crate) fn read_run(
     (candidates, spread, seed): (usize, f64, u64),
 ) -> Result<(GuideCard, Dims, Vec<NamedTensor>), CheckpointError> {
     let dir = run.join("checkpoint");
+    if !dir.join("state.json").exists() {
+        return Err(CheckpointError::Mismatch {
+            path: run.to_path_buf(),
+            message: "it is not a training run's folder (it has no checkpoint/state.json): \
+                      pass the folder `dexcube train --out` wrote"
+                .to_string(),
+        });
+    }
     let state: RunState = checkpoint::load_json(&dir.join("state.json"))?;
     let mut tensors = Vec::new();
     let mut critics = 0;

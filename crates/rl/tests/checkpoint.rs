@@ -879,6 +879,8 @@ fn a_policy_guided_by_its_run_s_critics_ships_them_and_bad_critics_are_clear_err
     assert!(err(again).contains("guided already"));
     let joined = Policy::ensemble(&[dir.join("moved"), policy.clone()], &dir.join("x"), "test");
     assert!(err(joined).contains("guided by the critics of"));
+    let no_run = Policy::guide(&policy, &dir.join("x"), (4, 0.2, 0), &dir.join("y"), "test");
+    assert!(err(no_run).contains("not a training run's folder"));
     // The critics of a run of another width under this run's state.
     let small = small_network_run("dexcube-rl-guide-small");
     let critic = dir.join("checkpoint").join("critic.safetensors");
