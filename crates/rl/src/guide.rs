@@ -172,18 +172,27 @@ impl CriticGuide {
         })
     }
 
+    /// `proposed` and the candidates around it, each moved along one of the directions and
+    /// clipped to the action range.
+    fn candidates(&self, proposed: Vec<f64>) -> Vec<Vec<f64>> {
+        let moved: Vec<Vec<f64>> = self
+            .directions
+            .iter()
+            .map(|direction| {
+                proposed
+                    .iter()
+                    .zip(direction)
+                    .map(|(a, d)| (a + self.spread * d).clamp(-1.0, 1.0))
+                    .collect()
+            })
+            .collect();
+        std::iter::once(proposed).chain(moved).collect()
+    }
+
     /// Of `proposed` and the candidates around it, the action the critics value most for
     /// this observation and goal.
     pub fn choose(&self, observation: &[f64], goal: &[f64], proposed: Vec<f64>) -> Vec<f64> {
-        let mut actions = vec![proposed];
-        for direction in &self.directions {
-            let moved = actions[0]
-                .iter()
-                .zip(direction)
-                .map(|(a, d)| (a + self.spread * d).clamp(-1.0, 1.0))
-                .collect();
-            actions.push(moved);
-        }
+        let mut actions = self.candidates(proposed);
         let n = actions.len();
         let x = network_inputs(
             &self.observation_norm,
@@ -254,19 +263,6 @@ mod tests {
         }
     }
 
-    /// Every candidate the guide weighs, the proposed action first.
-    fn candidates(guide: &CriticGuide, proposed: &[f64]) -> Vec<Vec<f64>> {
-        std::iter::once(proposed.to_vec())
-            .chain(guide.directions.iter().map(|d| {
-                proposed
-                    .iter()
-                    .zip(d)
-                    .map(|(a, d)| (a + guide.spread * d).clamp(-1.0, 1.0))
-                    .collect()
-            }))
-            .collect()
-    }
-
     fn sum(action: &[f64]) -> f64 {
         action.iter().sum()
     }
@@ -283,7 +279,8 @@ mod tests {
     fn the_candidate_the_critic_values_most_is_taken() {
         let guide = guide(&[1.0], 16);
         let chosen = guide.choose(&[0.5], &[0.1], PROPOSED.to_vec());
-        let best = candidates(&guide, &PROPOSED)
+        let best = guide
+            .candidates(PROPOSED.to_vec())
             .into_iter()
             .max_by(|a, b| sum(a).total_cmp(&sum(b)))
             .unwrap();
@@ -301,7 +298,8 @@ mod tests {
         // -|sum|, so the candidate with the sum nearest zero wins.
         let guide = guide(&[1.0, -1.0], 16);
         let chosen = guide.choose(&[0.5], &[0.1], PROPOSED.to_vec());
-        let nearest = candidates(&guide, &PROPOSED)
+        let nearest = guide
+            .candidates(PROPOSED.to_vec())
             .into_iter()
             .min_by(|a, b| sum(a).abs().total_cmp(&sum(b).abs()))
             .unwrap();
