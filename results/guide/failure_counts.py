@@ -14,21 +14,16 @@ import os, sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'starts'))
 from drops_by_start import load
-from merge_starts import safetensors_bytes
+from merge_starts import write_starts
 from pair_failures import marks
 
 
 def write_marked(path, recording, flags):
     """`recording`'s starts and goals with `flags` as its failure marks, written to `path`."""
-    tensors = [(name, [len(recording[name]), len(recording[name][0])], [v for row in recording[name] for v in row])
-               for name in ('state', 'goal')]
-    tensors.append(('failed', [len(flags)], [1.0 if x else 0.0 for x in flags]))
     metadata = dict(recording['__metadata__'])
     metadata['command'] = (f"python3 results/guide/failure_counts.py --always-out {path} ... (marks: failed in "
                            f"every recording; starts from {metadata.get('command', 'an unnamed recording')})")
-    with open(path + '.tmp', 'wb') as out:
-        out.write(safetensors_bytes(tensors, metadata))
-    os.replace(path + '.tmp', path)
+    write_starts(path, recording['state'], recording['goal'], flags, metadata)
 
 
 def main():

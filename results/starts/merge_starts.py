@@ -41,6 +41,17 @@ def safetensors_bytes(tensors, metadata):
     return struct.pack('<Q', len(text)) + text + b''.join(blobs)
 
 
+def write_starts(path, state, goal, failed, metadata):
+    """Writes start rows, goal rows and failure marks as a recording at `path`, through a temporary file and a rename."""
+    tensors = [(name, [len(rows), len(rows[0])], [x for row in rows for x in row])
+               for name, rows in (('state', state), ('goal', goal))]
+    tensors.append(('failed', [len(failed)], [float(x) for x in failed]))
+    tmp = path + '.tmp'
+    with open(tmp, 'wb') as f:
+        f.write(safetensors_bytes(tensors, metadata))
+    os.replace(tmp, path)
+
+
 def main():
     if len(sys.argv) < 4:
         sys.exit(__doc__)
@@ -60,16 +71,11 @@ def main():
             if width(recording[name], name, path) != widths[name]:
                 refuse(f"{inputs[0]} and {path} have '{name}' rows of different sizes")
     failed = [x for recording in recordings for x in recording['failed']]
-    tensors = [(name, [len(failed), size], [x for r in recordings for row in r[name] for x in row])
-               for name, size in widths.items()]
-    tensors.append(('failed', [len(failed)], failed))
     metadata = {key: value for key, value in first_marks.items() if value is not None}
     sources = '; '.join(f"{path}: {r['__metadata__'].get('command', '?')}" for path, r in zip(inputs, recordings))
     metadata['command'] = f"python3 results/starts/merge_starts.py {out} {' '.join(inputs)} (from {sources})"
-    tmp = out + '.tmp'
-    with open(tmp, 'wb') as f:
-        f.write(safetensors_bytes(tensors, metadata))
-    os.replace(tmp, out)
+    rows = {name: [row for r in recordings for row in r[name]] for name in widths}
+    write_starts(out, rows['state'], rows['goal'], failed, metadata)
     print(f"{out}: {len(failed)} starts, {sum(1 for x in failed if x)} failed, from {len(inputs)} recordings")
 
 

@@ -17,26 +17,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::agent::{Dims, network_inputs};
-use crate::checkpoint::{self, CheckpointError};
+use crate::agent::{Dims, input_row_into};
+use crate::checkpoint::CheckpointError;
 use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
 use crate::params::{self, NamedTensor};
+use crate::train;
 use dexcube_env::random::standard_normal;
-
-/// The parts of a run's `state.json` a guide reads.
-#[derive(Deserialize)]
-struct RunState {
-    dims: Dims,
-    config: HiddenSizes,
-    observation_norm: Normalizer,
-    goal_norm: Normalizer,
-}
-
-#[derive(Deserialize)]
-struct HiddenSizes {
-    hidden: Vec<usize>,
-}
 
 /// A guide as a policy's card keeps it; its critics' weights are the policy's tensors named
 /// `guide.critic{j}.…`.
@@ -68,45 +55,25 @@ pub(crate) fn read_run(
     run: &Path,
     (candidates, spread, seed): (usize, f64, u64),
 ) -> Result<(GuideCard, Dims, Vec<NamedTensor>), CheckpointError> {
-    let dir = run.join("checkpoint");
-    if !dir.join("state.json").exists() {
-        return Err(CheckpointError::Mismatch {
-            path: run.to_path_buf(),
-            message: "it is not a training run's folder (it has no checkpoint/state.json): \
-                      pass the folder `dexcube train --out` wrote"
-                .to_string(),
-        });
-    }
-    let state: RunState = checkpoint::load_json(&dir.join("state.json"))?;
-    let mut tensors = Vec::new();
-    let mut critics = 0;
-    for name in ["critic", "critic2"] {
-        let path = dir.join(format!("{name}.safetensors"));
-        if critics > 0 && !path.exists() {
-            break;
-        }
-        let prefix = critic_prefix(critics);
-        tensors.extend(
-            checkpoint::load_tensors(&path)?
-                .into_iter()
-                .map(|t| NamedTensor {
-                    name: format!("{prefix}{}", t.name),
-                    ..t
-                }),
-        );
-        critics += 1;
-    }
+    let read = train::read_critics(run)?;
+    let critics = read.critics.len();
+    let tensors = read
+        .critics
+        .into_iter()
+        .enumerate()
+        .flat_map(|(j, critic)| params::prefixed(critic, &critic_prefix(j)))
+        .collect();
     let card = GuideCard {
         run: run.to_path_buf(),
-        hidden: state.config.hidden,
+        hidden: read.hidden,
         critics,
-        observation_norm: state.observation_norm,
-        goal_norm: state.goal_norm,
+        observation_norm: read.observation_norm,
+        goal_norm: read.goal_norm,
         candidates,
         spread,
         seed,
     };
-    Ok((card, state.dims, tensors))
+    Ok((card, read.dims, tensors))
 }
 
 /// A run's critics, and the candidates they choose among.
@@ -134,16 +101,7 @@ impl CriticGuide {
         let input = dims.observation + dims.goal + dims.action;
         let critics = (0..card.critics)
             .map(|j| {
-                let prefix = critic_prefix(j);
-                let own: Vec<NamedTensor> = tensors
-                    .iter()
-                    .filter_map(|t| {
-                        Some(NamedTensor {
-                            name: t.name.strip_prefix(&prefix)?.to_string(),
-                            ..t.clone()
-                        })
-                    })
-                    .collect();
+                let own = params::under_prefix(tensors, &critic_prefix(j));
                 let critic = Mlp::new(input, &card.hidden, 1, device);
                 params::write(critic, &own, |_, given| given.to_vec()).map_err(|e| {
                     CheckpointError::Mismatch {
@@ -193,18 +151,22 @@ impl CriticGuide {
     /// this observation and goal.
     pub fn choose(&self, observation: &[f64], goal: &[f64], proposed: Vec<f64>) -> Vec<f64> {
         let mut actions = self.candidates(proposed);
-        let n = actions.len();
-        let x = network_inputs(
-            &self.observation_norm,
-            &self.goal_norm,
-            &observation[..self.observation_norm.size()].repeat(n),
-            &goal.repeat(n),
-            n,
-            &self.device,
+        // The observation and goal are normalised once; every candidate shares them.
+        let mut row = Vec::new();
+        input_row_into(
+            (&self.observation_norm, &self.goal_norm),
+            observation,
+            goal,
+            &mut row,
         );
-        let flat: Vec<f32> = actions.iter().flatten().map(|&a| a as f32).collect();
-        let u = Tensor::from_data(TensorData::new(flat, [n, self.action]), &self.device);
-        let input = Tensor::cat(vec![x, u], 1);
+        let width = row.len() + self.action;
+        let mut inputs = Vec::with_capacity(actions.len() * width);
+        for action in &actions {
+            inputs.extend_from_slice(&row);
+            inputs.extend(action.iter().map(|&a| a as f32));
+        }
+        let shape = [actions.len(), width];
+        let input = Tensor::from_data(TensorData::new(inputs, shape), &self.device);
         let mut q = self.critics[0].forward(input.clone());
         for critic in &self.critics[1..] {
             q = q.min_pair(critic.forward(input.clone()));

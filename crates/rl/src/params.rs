@@ -36,6 +36,31 @@ pub fn l1_distance(a: &[NamedTensor], b: &[NamedTensor]) -> f32 {
         .sum()
 }
 
+/// `tensors` with `prefix` put before their names, as one file stores several networks (an
+/// ensemble's partners, a guide's critics).
+pub fn prefixed(tensors: Vec<NamedTensor>, prefix: &str) -> Vec<NamedTensor> {
+    tensors
+        .into_iter()
+        .map(|t| NamedTensor {
+            name: format!("{prefix}{}", t.name),
+            ..t
+        })
+        .collect()
+}
+
+/// The tensors of `tensors` stored under `prefix`, with it taken off their names.
+pub fn under_prefix(tensors: &[NamedTensor], prefix: &str) -> Vec<NamedTensor> {
+    tensors
+        .iter()
+        .filter_map(|t| {
+            Some(NamedTensor {
+                name: t.name.strip_prefix(prefix)?.to_string(),
+                ..t.clone()
+            })
+        })
+        .collect()
+}
+
 /// Every float parameter of `module`, in visiting order.
 pub fn read<M: Module>(module: &M) -> Vec<NamedTensor> {
     struct Reader {

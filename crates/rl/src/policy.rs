@@ -243,11 +243,10 @@ impl Policy {
                     ),
                 ));
             }
-            let prefix = partner_prefix(partners.len());
-            tensors.extend(member_tensors.into_iter().map(|t| NamedTensor {
-                name: format!("{prefix}{}", t.name),
-                ..t
-            }));
+            tensors.extend(params::prefixed(
+                member_tensors,
+                &partner_prefix(partners.len()),
+            ));
             partners.push(PartnerCard {
                 dims,
                 hidden: card.config.hidden,
@@ -336,17 +335,7 @@ impl Policy {
             .iter()
             .enumerate()
             .map(|(i, partner)| {
-                let prefix = partner_prefix(i);
-                let own: Vec<NamedTensor> = tensors
-                    .iter()
-                    .filter_map(|t| {
-                        let name = t.name.strip_prefix(&prefix)?;
-                        Some(NamedTensor {
-                            name: name.to_string(),
-                            ..t.clone()
-                        })
-                    })
-                    .collect();
+                let own = params::under_prefix(&tensors, &partner_prefix(i));
                 build(partner.dims, &partner.hidden, &own)
             })
             .collect::<Result<_, _>>()?;

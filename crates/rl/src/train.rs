@@ -227,6 +227,43 @@ const TWIN_FILES: [&str; 2] = ["critic2", "target_critic2"];
 /// The anchor's weights in a checkpoint, for a run fine-tuned with one.
 const ANCHOR_FILE: &str = "anchor.safetensors";
 
+/// The critics in the checkpoint of a training run (the first, and TD3's second where the run
+/// had one), with what they read their inputs through: what a guide takes from a run.
+pub(crate) struct RunCritics {
+    pub dims: Dims,
+    pub hidden: Vec<usize>,
+    pub observation_norm: Normalizer,
+    pub goal_norm: Normalizer,
+    pub critics: Vec<Vec<crate::params::NamedTensor>>,
+}
+
+/// Reads the critics of the run in `dir`.
+pub(crate) fn read_critics(dir: &Path) -> Result<RunCritics, CheckpointError> {
+    let checkpoint_dir = dir.join("checkpoint");
+    let state_path = checkpoint_dir.join("state.json");
+    if !state_path.exists() {
+        return Err(CheckpointError::Mismatch {
+            path: dir.to_path_buf(),
+            message: "it is not a training run's folder (it has no checkpoint/state.json): \
+                      pass the folder `dexcube train --out` wrote"
+                .to_string(),
+        });
+    }
+    let state: TrainState = checkpoint::load_json(&state_path)?;
+    let file = |name: &str| checkpoint_dir.join(format!("{name}.safetensors"));
+    let mut critics = vec![checkpoint::load_tensors(&file(NETWORK_FILES[1]))?];
+    if file(TWIN_FILES[0]).exists() {
+        critics.push(checkpoint::load_tensors(&file(TWIN_FILES[0]))?);
+    }
+    Ok(RunCritics {
+        dims: state.dims,
+        hidden: state.config.hidden,
+        observation_norm: state.observation_norm,
+        goal_norm: state.goal_norm,
+        critics,
+    })
+}
+
 /// A seed for the `batch`-th batch of episodes, distinct for training and testing.
 fn episode_seed(seed: u64, batch: u64, test: bool) -> u64 {
     seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (batch << 20) ^ ((test as u64) << 62)
