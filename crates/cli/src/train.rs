@@ -116,6 +116,13 @@ pub struct TrainArgs {
         requires = "starts"
     )]
     failed_weight: f64,
+    /// Vary the physics of each training episode by this spread S (domain randomisation):
+    /// every geom's friction, the object's mass and every joint's damping are each scaled by
+    /// a factor drawn log-uniform between 1/(1+S) and 1+S from the episode's seed; the test
+    /// episodes of each epoch are varied alike (0: the scene's own physics, as the paper). A
+    /// resume must say it again.
+    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    physics_spread: f64,
 }
 
 /// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
@@ -248,9 +255,9 @@ pub fn guide(args: GuideArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Refuses to resume a run with other recorded starts, or at another control rate, than it
-/// began with (its checkpoint's card names them), since the card would then say it trained
-/// on starts, or at a rate, it did not.
+/// Refuses to resume a run with other recorded starts, at another control rate, or under
+/// other varied physics than it began with (its checkpoint's card names them), since the
+/// card would then say it trained on starts, at a rate or on physics it did not.
 fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {
     // A missing or unreadable checkpoint is the trainer's to report.
     let Ok(begun) = dexcube_rl::train::RunCurve::read(run) else {
@@ -296,6 +303,15 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
             args.choice.control_rate
         );
     }
+    // Runs from before physics could be varied ran on the scene's own.
+    let begun_spread = environment["physics_spread"].as_f64().unwrap_or(0.0);
+    if begun_spread != args.physics_spread {
+        bail!(
+            "{} began with --physics-spread {begun_spread}; resume it with the same, not {}",
+            run.display(),
+            args.physics_spread
+        );
+    }
     Ok(())
 }
 
@@ -307,6 +323,12 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     } = args.workers;
     if envs == 0 || threads == 0 || args.epochs == 0 {
         bail!("--envs, --threads and --epochs must be at least 1");
+    }
+    if !(args.physics_spread >= 0.0 && args.physics_spread.is_finite()) {
+        bail!(
+            "--physics-spread must be 0 or more (0.3 scales each by 1/1.3 to 1.3), not {}",
+            args.physics_spread
+        );
     }
     if args.quarter_goals && matches!(args.choice.env, EnvKind::Rot) {
         bail!("--quarter-goals is for LayerOpEnv (train layer)");
@@ -446,6 +468,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "start_share": args.starts.as_ref().map(|_| args.start_share),
             "failed_weight": args.starts.as_ref().map(|_| args.failed_weight),
             "control_substeps": rate.substeps(),
+            "physics_spread": args.physics_spread,
         }),
     };
     eprintln!(
@@ -473,6 +496,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_view(view)
                     .with_starts(starts.clone())
                     .with_control_rate(rate)
+                    .with_physics_spread(args.physics_spread)
             };
             train(make, config, &options)?
         }
@@ -489,6 +513,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_view(view)
                     .with_starts(starts.clone())
                     .with_control_rate(rate)
+                    .with_physics_spread(args.physics_spread)
             };
             train(make, config, &options)?
         }

@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
 use dexcube_sim::rotation::Quat;
-use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, Pose, Scene, SceneKind, Sim};
-use rand::SeedableRng;
+use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, PhysicsScales, Pose, Scene, SceneKind, Sim};
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::goal::Goal;
@@ -165,6 +165,9 @@ pub struct HandObject {
     /// The most an actuator's target may move in one control step, in action units (the
     /// action range is 2 wide); `None` (the paper's) lets it jump anywhere at once.
     pub action_slew: Option<f64>,
+    /// How far each episode's physics is varied ([`HandObject::begin_episode`]); 0, the
+    /// paper's, keeps the scene's own.
+    pub physics_spread: f64,
 }
 
 impl HandObject {
@@ -186,13 +189,26 @@ impl HandObject {
             steps: 0,
             rate: ControlRate::PAPER,
             action_slew: None,
+            physics_spread: 0.0,
         }
     }
 
-    /// Re-seeds the generator if asked.
-    pub fn seed(&mut self, seed: Option<u64>) {
+    /// Begins an episode: re-seeds the generator if asked, then, with a physics spread s,
+    /// draws the episode's friction, object mass and damping scales from it, each
+    /// log-uniform between 1/(1 + s) and 1 + s ([`Sim::set_physics_scales`]).
+    pub fn begin_episode(&mut self, seed: Option<u64>) {
         if let Some(seed) = seed {
             self.rng = ChaCha8Rng::seed_from_u64(seed);
+        }
+        if self.physics_spread > 0.0 {
+            let (spread, rng) = (self.physics_spread, &mut self.rng);
+            let mut scale = || (1.0 + spread).powf(rng.random_range(-1.0..=1.0));
+            let scales = PhysicsScales {
+                friction: scale(),
+                object_mass: scale(),
+                damping: scale(),
+            };
+            self.sim.set_physics_scales(scales);
         }
     }
 

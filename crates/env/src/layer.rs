@@ -386,6 +386,13 @@ impl LayerOpEnv {
         self
     }
 
+    /// The same environment with each episode's physics varied by `spread`
+    /// ([`HandObject::begin_episode`]; 0 keeps the scene's own, as the paper does).
+    pub fn with_physics_spread(mut self, spread: f64) -> LayerOpEnv {
+        self.hand.physics_spread = spread;
+        self
+    }
+
     /// The same environment with each actuator's target moving at most `slew` action units
     /// per control step ([`HandObject::action_slew`]).
     pub fn with_action_slew(mut self, slew: Option<f64>) -> LayerOpEnv {
@@ -480,7 +487,7 @@ impl GoalEnv for LayerOpEnv {
     }
 
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
-        self.hand.seed(seed);
+        self.hand.begin_episode(seed);
         if let Some(mix) = self.starts.clone()
             && let Some(start) = mix.pick(seed, &mut self.hand.rng)
             && let Ok(first) = self.reset_from(start)

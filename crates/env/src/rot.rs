@@ -151,6 +151,13 @@ impl CubeRotEnv {
         self
     }
 
+    /// The same environment with each episode's physics varied by `spread`
+    /// ([`HandObject::begin_episode`]; 0 keeps the scene's own, as the paper does).
+    pub fn with_physics_spread(mut self, spread: f64) -> CubeRotEnv {
+        self.hand.physics_spread = spread;
+        self
+    }
+
     /// How many numbers Stage 1 observes without a view beyond the paper's; a trained
     /// policy's view is told from how many more it takes ([`View::after`]: 62 with the
     /// misalignment, 67 with the grip, 68 with both).
@@ -284,7 +291,7 @@ impl GoalEnv for CubeRotEnv {
     }
 
     fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
-        self.hand.seed(seed);
+        self.hand.begin_episode(seed);
         if let Some(mix) = self.starts.clone()
             && let Some(start) = mix.pick(seed, &mut self.hand.rng)
             && let Ok(first) = self.reset_from(start)

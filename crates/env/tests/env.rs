@@ -800,3 +800,45 @@ fn a_slew_limit_moves_each_target_at_most_that_far_per_step() {
     }
     assert!(close(slewed.sim().action()), "reached within 2 / 0.3 steps");
 }
+
+/// Varied physics: each episode draws its friction, cube mass and damping scales from its
+/// seed, within the spread, the same again for the same seed and others for another; a
+/// spread of 0 keeps the scene's own physics.
+#[test]
+fn varied_physics_draws_each_episodes_scales_from_its_seed() {
+    let scene = Scene::load(dexcube_sim::SceneKind::Cube).unwrap();
+    let scales = |spread: f64, seed: u64| {
+        let mut env =
+            LayerOpEnv::with_scene(scene.clone(), LayerMove::UPrime, LayerGoals::Training)
+                .with_physics_spread(spread);
+        env.reset(Some(seed));
+        let (now, nominal) = (env.sim().data().model(), scene.model());
+        let friction = (0..nominal.geom_friction().len())
+            .find(|&g| nominal.geom_friction()[g][0] > 0.0)
+            .unwrap();
+        let damped = (0..nominal.dof_damping().len())
+            .find(|&d| nominal.dof_damping()[d] > 0.0)
+            .unwrap();
+        let cube = (0..nominal.body_mass().len())
+            .find(|&b| {
+                scene.model().body_subtreemass()[b] > 0.0
+                    && now.body_mass()[b] != nominal.body_mass()[b]
+            })
+            .map_or(1.0, |b| now.body_mass()[b] / nominal.body_mass()[b]);
+        [
+            now.geom_friction()[friction][0] / nominal.geom_friction()[friction][0],
+            cube,
+            now.dof_damping()[damped] / nominal.dof_damping()[damped],
+        ]
+    };
+    assert_eq!(scales(0.0, 5), [1.0; 3], "the paper's physics");
+    let drawn = scales(0.3, 5);
+    assert!(
+        drawn
+            .iter()
+            .all(|s| (1.0 / 1.3..=1.3).contains(s) && *s != 1.0),
+        "{drawn:?}"
+    );
+    assert_eq!(scales(0.3, 5), drawn, "the same seed, the same physics");
+    assert_ne!(scales(0.3, 6), drawn, "another seed, other physics");
+}

@@ -5,7 +5,12 @@
 //! 90), by how far it sits from the palm's resting point across the palm, and by which side
 //! of that point it sits (the fingertips lie towards -x).
 //!
-//! `cargo run --release -p dexcube-operator --example stage2_start_geometry -- STARTS...`
+//! With `--mark-side SIDE OUT` (SIDE one of x-, x+, y-, y+) it also writes the starts, joined,
+//! to OUT with every start on that side of the resting point marked as failed beside those
+//! the recorded policy failed from, so that `dexcube train --starts OUT --failed-weight W`
+//! draws that side W times as often.
+//!
+//! `cargo run --release -p dexcube-operator --example stage2_start_geometry -- [--mark-side SIDE OUT] STARTS...`
 
 use std::path::Path;
 
@@ -34,17 +39,48 @@ struct Start {
     failed: bool,
 }
 
+/// The four sides of the resting point, as `--mark-side` names them, with their directions
+/// across the palm.
+const SIDES: [(&str, &str, [f64; 2]); 4] = [
+    ("x-", "x < 0 (towards the fingertips)", [-1.0, 0.0]),
+    ("x+", "x > 0 (towards the wrist)", [1.0, 0.0]),
+    ("y-", "y < 0", [0.0, -1.0]),
+    ("y+", "y > 0", [0.0, 1.0]),
+];
+
+fn on_side(offset: [f64; 2], side: [f64; 2]) -> bool {
+    offset[0] * side[0] + offset[1] * side[1] > 0.0
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let paths: Vec<String> = std::env::args().skip(1).collect();
+    let usage = "usage: stage2_start_geometry [--mark-side x-|x+|y-|y+ OUT] STARTS...";
+    let mut paths: Vec<String> = std::env::args().skip(1).collect();
+    let mark = match paths.first().map(String::as_str) {
+        Some("--mark-side") if paths.len() > 3 => {
+            let out = paths.remove(2);
+            let name = paths.remove(1);
+            paths.remove(0);
+            let side = SIDES
+                .iter()
+                .find(|(tag, _, _)| *tag == name)
+                .ok_or(format!("--mark-side takes x-, x+, y- or y+, not '{name}'"))?;
+            Some((side, out))
+        }
+        Some("--mark-side") => return Err(usage.into()),
+        _ => None,
+    };
     if paths.is_empty() {
-        return Err("usage: stage2_start_geometry STARTS...".into());
+        return Err(usage.into());
     }
     let scene = Scene::load(SceneKind::Cube)?;
     let resting = dexcube_env::resting_point(&mut Sim::new(scene.clone()));
     let mut env = LayerOpEnv::with_scene(scene, LayerMove::UPrime, LayerGoals::Evaluation);
     let mut starts = Vec::new();
+    let mut marked = Vec::new();
+    let mut first_origin = None;
     for path in &paths {
-        let (recorded, _) = dexcube_rl::start_file::load_starts(Path::new(path))?;
+        let (recorded, origin) = dexcube_rl::start_file::load_starts(Path::new(path))?;
+        first_origin.get_or_insert(origin);
         for start in &recorded {
             env.reset_from(start)?;
             let pose = env.sim().object_pose();
@@ -55,9 +91,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .min_by(|a, b| a[2].abs().total_cmp(&b[2].abs()))
                 .expect("three faces");
             let yaw = side[1].atan2(side[0]).to_degrees().rem_euclid(90.0);
+            let offset = [0, 1].map(|k| 1000.0 * (pose.position[k] - resting[k]));
+            if let Some(((_, _, side), _)) = &mark {
+                let mut start = start.clone();
+                start.failed |= on_side(offset, *side);
+                marked.push(start);
+            }
             starts.push(Start {
                 yaw: yaw.min(90.0 - yaw),
-                offset: [0, 1].map(|k| 1000.0 * (pose.position[k] - resting[k])),
+                offset,
                 failed: start.failed,
             });
         }
@@ -80,14 +122,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("  {low:>2.0} to {high:>3.0} mm: {off}");
     }
     println!("by the side of the resting point (x towards the wrist, y across the palm):");
-    for (name, side) in [
-        ("x < 0 (towards the fingertips)", [-1.0, 0.0]),
-        ("x > 0 (towards the wrist)", [1.0, 0.0]),
-        ("y < 0", [0.0, -1.0]),
-        ("y > 0", [0.0, 1.0]),
-    ] {
-        let on_side = count(&|s| s.offset[0] * side[0] + s.offset[1] * side[1] > 0.0);
-        println!("  {name}: {on_side}");
+    for (_, name, side) in SIDES {
+        let there = count(&|s| on_side(s.offset, side));
+        println!("  {name}: {there}");
+    }
+    if let (Some(((tag, _, _), out)), Some(mut origin)) = (mark, first_origin) {
+        origin.command = format!(
+            "cargo run --release -p dexcube-operator --example stage2_start_geometry -- \
+             --mark-side {tag} {out} {} (the first's command: {})",
+            paths.join(" "),
+            origin.command
+        );
+        dexcube_rl::start_file::save_starts(Path::new(&out), &marked, &origin)?;
+        let failed = marked.iter().filter(|s| s.failed).count();
+        println!("{out}: {} starts, {failed} marked failed", marked.len());
     }
     Ok(())
 }

@@ -16,4 +16,4 @@ pub mod sim;
 
 pub use error::SimError;
 pub use scene::{GRIP_PARTS, HAND_ACTUATORS, HAND_JOINTS, Scene, SceneKind, assets_dir};
-pub use sim::{Pose, SUBSTEPS, Sim};
+pub use sim::{PhysicsScales, Pose, SUBSTEPS, Sim};

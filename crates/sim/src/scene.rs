@@ -139,6 +139,7 @@ pub struct Scene {
     ctrl_half_range: [f64; HAND_ACTUATORS],
     object: ObjectJoints,
     geom_owners: Vec<GeomOwner>,
+    object_bodies: Vec<usize>,
 }
 
 impl Scene {
@@ -211,6 +212,9 @@ impl Scene {
             .iter()
             .map(|&body| body_owners[body as usize])
             .collect();
+        let object_bodies = (0..body_owners.len())
+            .filter(|&body| body_owners[body] == GeomOwner::Object)
+            .collect();
         Ok(Arc::new(Scene {
             kind,
             path,
@@ -220,12 +224,18 @@ impl Scene {
             ctrl_half_range,
             object,
             geom_owners,
+            object_bodies,
         }))
     }
 
     /// What each geom belongs to, by geom id.
     pub(crate) fn geom_owners(&self) -> &[GeomOwner] {
         &self.geom_owners
+    }
+
+    /// The object's bodies (the cube and its cubelets), by body id.
+    pub(crate) fn object_bodies(&self) -> &[usize] {
+        &self.object_bodies
     }
 
     pub fn kind(&self) -> SceneKind {

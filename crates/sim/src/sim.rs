@@ -1,6 +1,7 @@
 //! One running simulation of a scene: its own `MjData` over the scene's shared model, a
-//! control step of 20 physics substeps, blow-up detection, and the state every environment
-//! reads (hand joints, the object's pose and velocities, the hand's grip on it).
+//! control step of 20 physics substeps, blow-up detection, the state every environment
+//! reads (hand joints, the object's pose and velocities, the hand's grip on it), and the
+//! scene's physics scaled for one episode ([`PhysicsScales`]).
 
 use std::sync::Arc;
 
@@ -51,6 +52,25 @@ pub struct Pose {
     pub orientation: Quat,
 }
 
+/// Multipliers on a scene's physics, for training under varied physics (domain
+/// randomisation, as OpenAI et al. 2019 trained their Shadow Hand): every geom's friction
+/// (sliding, torsional and rolling), the object's mass and inertia, and every joint's damping.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhysicsScales {
+    pub friction: f64,
+    pub object_mass: f64,
+    pub damping: f64,
+}
+
+impl PhysicsScales {
+    /// The scene's own physics, as its MJCF gives it.
+    pub const NOMINAL: PhysicsScales = PhysicsScales {
+        friction: 1.0,
+        object_mass: 1.0,
+        damping: 1.0,
+    };
+}
+
 pub struct Sim {
     scene: Arc<Scene>,
     data: MjData<Arc<MjModel>>,
@@ -82,6 +102,35 @@ impl Sim {
 
     pub fn data_mut(&mut self) -> &mut MjData<Arc<MjModel>> {
         &mut self.data
+    }
+
+    /// Runs this simulation on the scene's physics scaled by `scales` until the next call,
+    /// resets included; [`PhysicsScales::NOMINAL`] puts the scene's own physics back. The
+    /// state is kept as it is.
+    pub fn set_physics_scales(&mut self, scales: PhysicsScales) {
+        let model = if scales == PhysicsScales::NOMINAL {
+            self.scene.model().clone()
+        } else {
+            let mut model = MjModel::clone(self.scene.model());
+            for friction in model.geom_friction_mut() {
+                friction.iter_mut().for_each(|f| *f *= scales.friction);
+            }
+            for &body in self.scene.object_bodies() {
+                model.body_mass_mut()[body] *= scales.object_mass;
+                model.body_inertia_mut()[body]
+                    .iter_mut()
+                    .for_each(|i| *i *= scales.object_mass);
+            }
+            model
+                .dof_damping_mut()
+                .iter_mut()
+                .for_each(|d| *d *= scales.damping);
+            // What MuJoCo derives from the masses (subtree masses, the inverse weights that
+            // scale constraint softness) follows them.
+            MjData::new(&mut model).set_const();
+            Arc::new(model)
+        };
+        self.data.swap_model(model);
     }
 
     /// Back to the model's initial state (the hand's joints at zero, the object on the palm).

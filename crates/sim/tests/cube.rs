@@ -3,7 +3,7 @@
 use dexcube_cube::{Face, Facelets, Move, parse_moves};
 use dexcube_sim::cube::{CubeState, read_puzzle, turn_face, turn_face_by, turned_since};
 use dexcube_sim::rotation::{self, about};
-use dexcube_sim::{Pose, Scene, SceneKind, Sim};
+use dexcube_sim::{PhysicsScales, Pose, Scene, SceneKind, Sim};
 
 fn cube_sim() -> Sim {
     let mut sim = Sim::new(Scene::load(SceneKind::Cube).expect("run scripts/setup first"));
@@ -289,9 +289,9 @@ fn a_restored_physics_state_continues_exactly() {
     assert_eq!(restored.physics_state(), before, "left as it was");
 }
 
-/// The cube's weight, newtons.
+/// The cube's weight, newtons, in the physics the simulation now runs on.
 fn cube_weight(sim: &Sim) -> f64 {
-    let model = sim.scene().model();
+    let model = sim.data().model();
     let body = model
         .name_to_id(
             mujoco_rs::wrappers::mj_model::MjtObjBase::mjOBJ_BODY,
@@ -299,6 +299,53 @@ fn cube_weight(sim: &Sim) -> f64 {
         )
         .expect("the cube's root body");
     model.body_subtreemass()[body] * 9.81
+}
+
+/// Scaled physics: a heavier cube weighs more on the palm, by its scale; friction and damping
+/// follow theirs; the nominal scales give the scene's own physics back.
+#[test]
+fn scaled_physics_weighs_on_the_palm_and_goes_back() {
+    let scene = Scene::load(SceneKind::Cube).expect("run scripts/setup first");
+    let scaled = PhysicsScales {
+        friction: 0.5,
+        object_mass: 1.5,
+        damping: 2.0,
+    };
+    let borne = |scales: PhysicsScales| {
+        let mut sim = Sim::new(scene.clone());
+        sim.set_physics_scales(scales);
+        sim.set_action(&[0.0; dexcube_sim::HAND_ACTUATORS]);
+        settle(&mut sim, 10);
+        (sim.grip().iter().sum::<f64>(), cube_weight(&sim))
+    };
+    let (nominal_force, nominal_weight) = borne(PhysicsScales::NOMINAL);
+    let (heavy_force, heavy_weight) = borne(PhysicsScales {
+        object_mass: 1.5,
+        ..PhysicsScales::NOMINAL
+    });
+    assert!(
+        (heavy_weight / nominal_weight - 1.5).abs() < 1e-9,
+        "the subtree mass follows: {heavy_weight} against {nominal_weight}"
+    );
+    assert!(
+        (1.35..1.65).contains(&(heavy_force / nominal_force)),
+        "the palm bears half as much again: {heavy_force} N against {nominal_force} N"
+    );
+    let mut sim = Sim::new(scene.clone());
+    sim.set_physics_scales(scaled);
+    let nominal = scene.model();
+    let model = sim.data().model();
+    for (now, was) in model.geom_friction().iter().zip(nominal.geom_friction()) {
+        assert_eq!(*now, was.map(|f| 0.5 * f));
+    }
+    for (now, was) in model.dof_damping().iter().zip(nominal.dof_damping()) {
+        assert_eq!(*now, 2.0 * was);
+    }
+    sim.set_physics_scales(PhysicsScales::NOMINAL);
+    let model = sim.data().model();
+    assert_eq!(model.geom_friction(), nominal.geom_friction());
+    assert_eq!(model.dof_damping(), nominal.dof_damping());
+    assert_eq!(model.body_mass(), nominal.body_mass());
 }
 
 /// The grip readout: the palm bears a cube resting on it, a closed hand presses with its
