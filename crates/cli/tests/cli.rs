@@ -551,6 +551,10 @@ fn train_refuses_settings_it_cannot_run() {
             "3 substeps per control step: use a number that divides",
         ),
         (
+            &["rot", "--physics-spread=-0.1"],
+            "--physics-spread must be 0 or more",
+        ),
+        (
             &["layer", "--object", "cube", "--intact"],
             "--intact is for CubeRotEnv",
         ),
@@ -671,10 +675,11 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
 /// that its card never names starts it did not train on: session 12's run began with none,
 /// session 13's with starts all drawn alike (a card from before the weight), and session
 /// 17's with failed starts drawn 20 times as often (a card that names the weight by Stage 1's
-/// failures, `dropped_weight`); and only at the control rate it began with (session 12's, from
-/// before the rate could be chosen, the paper's).
+/// failures, `dropped_weight`); only at the control rate it began with (session 12's, from
+/// before the rate could be chosen, the paper's); and only on the physics it began with
+/// (before physics could be varied, the scene's own).
 #[test]
-fn train_resumes_only_with_the_starts_and_the_rate_it_began_with() {
+fn train_resumes_only_with_the_starts_the_rate_and_the_physics_it_began_with() {
     let resume = |committed_run: &str, starts: &[&str]| {
         let run = std::env::temp_dir().join(format!("dexcube-cli-resume-{committed_run}"));
         let _ = std::fs::remove_dir_all(&run);
@@ -724,6 +729,14 @@ fn train_resumes_only_with_the_starts_and_the_rate_it_began_with() {
         ),
         2,
         "began acting every 20 substeps; resume it with --control-substeps 20, not 10",
+    );
+    assert_clean_failure(
+        &resume(
+            "rot-pair-cube-square-anchor5-seed0",
+            &["--physics-spread", "0.3"],
+        ),
+        2,
+        "began with --physics-spread 0; resume it with the same, not 0.3",
     );
 }
 
