@@ -711,6 +711,12 @@ pub struct EvalStageArgs {
     /// Default: the rate the policy was trained at. Only that rate can be --record'ed.
     #[arg(long = "control-substeps", value_name = "N")]
     control_rate: Option<ControlRate>,
+    /// Vary each episode's physics by this spread S, drawn from the episode's seed as `train
+    /// --physics-spread` draws it (friction, the object's mass and joint damping, each scaled
+    /// between 1/(1+S) and 1+S): how a policy fares on physics other than the one it is
+    /// judged on. 0, the default, is the scene's own physics, the only one --record writes.
+    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    physics_spread: f64,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -838,8 +844,18 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let wins_out_of_square = AtomicUsize::new(0);
     // Stage 1 episodes that kept the cube and ended with a layer turned, and of them successes.
     let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
+    let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
     let (thresholds, control_rate) = (setup.thresholds, setup.control_rate);
+    if !(args.physics_spread >= 0.0 && args.physics_spread.is_finite())
+        || args.record && args.physics_spread > 0.0
+    {
+        bail!(
+            "--physics-spread must be 0 or more, and 0 with --record (a policy's evaluation is on \
+             the scene's own physics), not {}",
+            args.physics_spread
+        );
+    }
+    setup.physics_spread = args.physics_spread;
     if args.record && control_rate != setup.trained_rate {
         bail!(
             "--record writes the policy's evaluation at the rate it was trained at ({} \
@@ -950,6 +966,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             ", acting every {control_rate} substeps ({} steps an episode)",
             control_rate.episode_steps()
         );
+    }
+    if args.physics_spread > 0.0 {
+        from += &format!(", physics varied by spread {}", args.physics_spread);
     }
     println!(
         "{what}: {wins}/{episodes} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), {from}, policy {}",

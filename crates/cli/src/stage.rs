@@ -33,6 +33,9 @@ pub struct StageSetup {
     pub trained_rate: ControlRate,
     /// The paper's success test: position (Stage 1) and angle thresholds.
     pub thresholds: (f64, f64),
+    /// How far each episode's physics is varied (`train --physics-spread`); 0, the scene's
+    /// own, unless a caller sets it.
+    pub physics_spread: f64,
 }
 
 impl StageSetup {
@@ -69,6 +72,7 @@ impl StageSetup {
             control_rate: control_rate.unwrap_or(trained_rate),
             trained_rate,
             thresholds,
+            physics_spread: 0.0,
             prefix,
         })
     }
@@ -99,7 +103,8 @@ impl StageSetup {
                 let goal = PolicyStage1::trained_goal(policy, self.rot_mode, prefix)?;
                 let env = CubeRotEnv::with_scene(self.scene.clone(), goal)
                     .with_view(view)
-                    .with_control_rate(self.control_rate);
+                    .with_control_rate(self.control_rate)
+                    .with_physics_spread(self.physics_spread);
                 Box::new(env.with_starts(starts))
             }
             EnvKind::Layer => {
@@ -110,7 +115,8 @@ impl StageSetup {
                 )
                 .with_goal(PolicyStage2::trained_goal(policy, prefix)?)
                 .with_view(view)
-                .with_control_rate(self.control_rate);
+                .with_control_rate(self.control_rate)
+                .with_physics_spread(self.physics_spread);
                 Box::new(env.with_starts(starts))
             }
         })

@@ -982,10 +982,11 @@ fn average_and_ensemble_write_a_policy_eval_stage_runs_and_refuse_members_that_d
     }
 }
 
-/// `eval-stage --control-substeps` runs a policy at another control rate and says so; the
-/// policy's card is written only at the rate it was trained at.
+/// `eval-stage --control-substeps` runs a policy at another control rate, and
+/// `--physics-spread` on varied physics, and each says so; the policy's card is written only
+/// at the rate it was trained at, on the scene's own physics.
 #[test]
-fn eval_stage_runs_a_policy_at_another_control_rate_and_records_only_its_own() {
+fn eval_stage_runs_a_policy_at_another_rate_or_physics_and_records_only_its_own() {
     let dir = std::env::temp_dir().join("dexcube-cli-eval-stage-rate");
     let (rot, layer) = (copy_policy("rot", &dir, "rot"), models().join("layer"));
     let eval = ["eval-stage", "rot", "--episodes", "1", "--threads", "1"];
@@ -1011,6 +1012,16 @@ fn eval_stage_runs_a_policy_at_another_control_rate_and_records_only_its_own() {
         2,
         "at the rate it was trained at (20 substeps), not at 10",
     );
+    let varied = [&eval[..], &rate[..4], &["--physics-spread", "0.3"]].concat();
+    let o = dexcube(&varied, "");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("seed 1000000, physics varied by spread 0.3, policy"),
+        "{}",
+        stdout(&o)
+    );
+    let o = dexcube(&[&varied[..], &["--record"]].concat(), "");
+    assert_clean_failure(&o, 2, "and 0 with --record (a policy's evaluation is on");
     assert_eq!(
         std::fs::read_to_string(dir.join("rot.json")).unwrap(),
         card_before
