@@ -10,11 +10,11 @@ use clap::Args;
 use dexcube_cube::{DistanceTable, format_moves, scrambles_at_distance};
 use dexcube_operator::eval::{Hooks, resting_point, run_cube};
 use dexcube_operator::{Event, Failure, Planner};
-use dexcube_sim::render::{DEFAULT_CAMERA, Frame, FrameRenderer, save_video};
 use dexcube_sim::{Scene, SceneKind, Sim};
 
 use crate::eval::{OperatorArgs, PolicyArgs};
 use crate::net;
+use crate::video::Video;
 
 /// Scrambles a cube and has the hand solve it with the shipped policies.
 #[derive(Args)]
@@ -61,23 +61,13 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     )?;
     let scene = Scene::load(SceneKind::Cube)?;
     let mut stages = files.load(resting_point()?)?;
-    let mut frames: Vec<Frame> = Vec::new();
-    let mut renderer = match &args.video {
-        Some(_) => Some(FrameRenderer::new(
-            &Sim::new(scene.clone()),
-            480,
-            360,
-            DEFAULT_CAMERA,
-        )?),
+    let mut video = match &args.video {
+        Some(path) => Some(Video::new(path, &Sim::new(scene.clone()))?),
         None => None,
     };
-    let mut render_error = None;
     let mut watch = |sim: &mut Sim| {
-        if let Some(r) = renderer.as_mut() {
-            match r.render(sim) {
-                Ok(frame) => frames.push(frame),
-                Err(e) => render_error = Some(e),
-            }
+        if let Some(video) = video.as_mut() {
+            video.watch(sim);
         }
     };
     let distance = args.distance;
@@ -155,11 +145,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         "({} randomisations, {} re-plans, {} control steps)",
         outcome.randomisations, outcome.replans, outcome.control_steps
     )?;
-    if let (Some(path), Some(e)) = (&args.video, render_error) {
-        eprintln!("warning: no video written to {}: {e}", path.display());
-    } else if let Some(path) = &args.video {
-        save_video(&frames, 25, path)?;
-        eprintln!("wrote {} ({} frames)", path.display(), frames.len());
+    if let Some(video) = video {
+        video.save()?;
     }
     Ok(if outcome.solved {
         ExitCode::SUCCESS

@@ -23,11 +23,12 @@ use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_rl::start_file::{StartsOrigin, save_starts};
 use dexcube_sim::cube::{read_puzzle, turned_since};
-use dexcube_sim::{Scene, SceneKind};
+use dexcube_sim::{Scene, SceneKind, Sim};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::env::{EnvKind, starts_for};
 use crate::stage::{StageSetup, meets_paper_test};
+use crate::video::Video;
 
 /// Which operator runs the plan.
 #[derive(Args, Clone, Copy)]
@@ -717,6 +718,10 @@ pub struct EvalStageArgs {
     /// judged on. 0, the default, is the scene's own physics, the only one --record writes.
     #[arg(long, default_value_t = 0.0, value_name = "S")]
     physics_spread: f64,
+    /// Also write a video of the first episode (.gif, or .mp4 with ffmpeg installed): it is
+    /// run once more on its own, as it ran among the others, to watch what the hand did.
+    #[arg(long, value_name = "FILE")]
+    video: Option<PathBuf>,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -807,13 +812,16 @@ fn episode(
     seed: u64,
     thresholds: (f64, f64),
     record: bool,
+    watch: &mut dyn FnMut(&mut Sim),
 ) -> EpisodeTrace {
     let (mut obs, _) = env.reset(Some(seed));
     let start = record.then(|| env.fresh_start());
     let puzzle_at_start = read_puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
+    watch(env.sim_mut());
     loop {
         let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
+        watch(env.sim_mut());
         hold = if meets_paper_test(&t.info, thresholds) {
             hold + 1
         } else {
@@ -903,7 +911,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 Some(_) => k as u64,
                 None => args.seed + k as u64,
             };
-            let trace = episode(env.as_mut(), policy, seed, thresholds, keep_starts);
+            let trace = episode(
+                env.as_mut(),
+                policy,
+                seed,
+                thresholds,
+                keep_starts,
+                &mut |_| {},
+            );
             let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);
@@ -939,6 +954,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         },
     )?;
     bar.finish_and_clear();
+    if let Some(path) = &args.video {
+        let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
+        let mut env = setup.env(&policy, numbered(&starts))?;
+        let mut video = Video::new(path, env.sim())?;
+        let first = if starts.is_some() { 0 } else { args.seed };
+        let watch = &mut |sim: &mut Sim| video.watch(sim);
+        episode(env.as_mut(), &policy, first, thresholds, false, watch);
+        video.save()?;
+    }
     let counts = endings.map(AtomicUsize::into_inner);
     let wins = counts[Ending::Success as usize];
     let (lo, hi) = wilson_interval(wins, episodes);

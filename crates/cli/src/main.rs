@@ -14,6 +14,7 @@ mod render;
 mod solve;
 mod stage;
 mod train;
+mod video;
 
 use std::process::ExitCode;
 

@@ -1155,3 +1155,43 @@ fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
     let o = from(&starts("starts-ens-train-seed1.safetensors"), "2");
     assert_clean_failure(&o, 2, "a share is a number from 0 to 1");
 }
+
+/// `eval-stage --video` writes the first episode as a video, one frame for its start and one
+/// for each control step, and counts the episodes as it would without one.
+#[test]
+fn eval_stage_writes_a_video_of_its_first_episode() {
+    let dir = std::env::temp_dir().join("dexcube-cli-eval-stage-video");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let video = dir.join("first.gif");
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let eval = [
+        "eval-stage",
+        "layer",
+        "--episodes",
+        "2",
+        "--threads",
+        "1",
+        "--rot-policy",
+        rot.to_str().unwrap(),
+        "--layer-policy",
+        layer.to_str().unwrap(),
+    ];
+    let o = dexcube(
+        &[&eval[..], &["--video", video.to_str().unwrap()]].concat(),
+        "",
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!("wrote {} (101 frames)", video.display())),
+        "{}",
+        stderr(&o)
+    );
+    assert!(std::fs::read(&video).unwrap().starts_with(b"GIF89a"));
+    let without = dexcube(&eval, "");
+    assert_eq!(
+        stdout(&o).lines().next(),
+        stdout(&without).lines().next(),
+        "the same count"
+    );
+}
