@@ -3,7 +3,8 @@
 //! must end up vertical (in pair mode either end of it may point up). It prints how many starts,
 //! and how many of them the recorded policy dropped the cube from, by how far that axis
 //! leans from vertical at the start and, for the quarter flips, by the compass direction it
-//! points in across the palm (azimuth in the world frame; the fingertips lie towards -x), and
+//! points in across the palm (azimuth in the world frame; the thumb lies towards -x and the
+//! fingertips towards -y; before session 38 this said the fingertips lay towards -x), and
 //! by how far the cube itself leans, whichever face it rests on.
 //!
 //! `cargo run --release -p dexcube-operator --example stage1_start_geometry -- STARTS...`

@@ -3,7 +3,9 @@
 //! of them the recorded policy failed from, by the cube's yaw on the palm (how far its side
 //! faces turn from square to the hand's axes, 0 to 45 degrees, a cube's sides repeating every
 //! 90), by how far it sits from the palm's resting point across the palm, and by which side
-//! of that point it sits (the fingertips lie towards -x).
+//! of that point it sits: the thumb lies towards -x and the little finger towards +x, the
+//! fingertips towards -y and the wrist towards +y (before session 38 this said the fingertips
+//! lay towards -x, and the sides were printed so).
 //!
 //! With `--mark-side SIDE OUT` (SIDE one of x-, x+, y-, y+) it also writes the starts, joined,
 //! to OUT with every start on that side of the resting point marked as failed beside those
@@ -42,10 +44,10 @@ struct Start {
 /// The four sides of the resting point, as `--mark-side` names them, with their directions
 /// across the palm.
 const SIDES: [(&str, &str, [f64; 2]); 4] = [
-    ("x-", "x < 0 (towards the fingertips)", [-1.0, 0.0]),
-    ("x+", "x > 0 (towards the wrist)", [1.0, 0.0]),
-    ("y-", "y < 0", [0.0, -1.0]),
-    ("y+", "y > 0", [0.0, 1.0]),
+    ("x-", "x < 0 (towards the thumb)", [-1.0, 0.0]),
+    ("x+", "x > 0 (towards the little finger)", [1.0, 0.0]),
+    ("y-", "y < 0 (towards the fingertips)", [0.0, -1.0]),
+    ("y+", "y > 0 (towards the wrist)", [0.0, 1.0]),
 ];
 
 fn on_side(offset: [f64; 2], side: [f64; 2]) -> bool {
@@ -121,7 +123,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let off = count(&|s| (low..high).contains(&s.offset[0].hypot(s.offset[1])));
         println!("  {low:>2.0} to {high:>3.0} mm: {off}");
     }
-    println!("by the side of the resting point (x towards the wrist, y across the palm):");
+    println!("by the side of the resting point (x across the palm, y along the hand):");
     for (_, name, side) in SIDES {
         let there = count(&|s| on_side(s.offset, side));
         println!("  {name}: {there}");
