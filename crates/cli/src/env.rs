@@ -258,6 +258,17 @@ impl EnvChoice {
     }
 }
 
+/// `--physics-spread S` for `train` and `eval-stage`: how far each episode's physics is
+/// varied, 0 (the scene's own) or more.
+pub fn physics_spread(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(spread) if spread >= 0.0 && spread.is_finite() => Ok(spread),
+        _ => Err(format!(
+            "--physics-spread must be 0 or more (0.3 scales each by 1/1.3 to 1.3), not '{text}'"
+        )),
+    }
+}
+
 /// The object each environment held before the object was an option: runs and cards on it
 /// keep their old names.
 pub fn original_object(env: EnvKind) -> ObjectKind {

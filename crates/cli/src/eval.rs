@@ -26,7 +26,7 @@ use dexcube_sim::cube::{read_puzzle, turned_since};
 use dexcube_sim::{Scene, SceneKind, Sim};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::env::{EnvKind, starts_for};
+use crate::env::{EnvKind, physics_spread, starts_for};
 use crate::stage::{StageSetup, meets_paper_test};
 use crate::video::Video;
 
@@ -716,7 +716,7 @@ pub struct EvalStageArgs {
     /// --physics-spread` draws it (friction, the object's mass and joint damping, each scaled
     /// between 1/(1+S) and 1+S): how a policy fares on physics other than the one it is
     /// judged on. 0, the default, is the scene's own physics, the only one --record writes.
-    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    #[arg(long, default_value_t = 0.0, value_name = "S", value_parser = physics_spread)]
     physics_spread: f64,
     /// Also write a video of the first episode (.gif, or .mp4 with ffmpeg installed): it is
     /// run once more on its own, as it ran among the others, to watch what the hand did.
@@ -854,9 +854,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
     let (thresholds, control_rate) = (setup.thresholds, setup.control_rate);
-    if !(args.physics_spread >= 0.0 && args.physics_spread.is_finite())
-        || args.record && args.physics_spread > 0.0
-    {
+    if args.record && args.physics_spread > 0.0 {
         bail!(
             "--physics-spread must be 0 or more, and 0 with --record (a policy's evaluation is on \
              the scene's own physics), not {}",
@@ -897,6 +895,11 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         args.record_starts.is_some(),
         std::sync::Mutex::new(Vec::new()),
     );
+    // Episode k begins from recorded start k, or from a fresh placement seeded seed + k.
+    let episode_seed = |k: usize| match starts {
+        Some(_) => k as u64,
+        None => args.seed + k as u64,
+    };
     let bar = ProgressBar::new(episodes as u64);
     in_parallel(
         args.threads,
@@ -907,14 +910,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             Ok((policy, env))
         },
         |(policy, env), k| {
-            let seed = match starts {
-                Some(_) => k as u64,
-                None => args.seed + k as u64,
-            };
             let trace = episode(
                 env.as_mut(),
                 policy,
-                seed,
+                episode_seed(k),
                 thresholds,
                 keep_starts,
                 &mut |_| {},
@@ -958,9 +957,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
         let mut env = setup.env(&policy, numbered(&starts))?;
         let mut video = Video::new(path, env.sim())?;
-        let first = if starts.is_some() { 0 } else { args.seed };
         let watch = &mut |sim: &mut Sim| video.watch(sim);
-        episode(env.as_mut(), &policy, first, thresholds, false, watch);
+        episode(
+            env.as_mut(),
+            &policy,
+            episode_seed(0),
+            thresholds,
+            false,
+            watch,
+        );
         video.save()?;
     }
     let counts = endings.map(AtomicUsize::into_inner);

@@ -12,7 +12,7 @@ use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
-use crate::env::{EnvChoice, EnvKind, starts_for};
+use crate::env::{EnvChoice, EnvKind, physics_spread, starts_for};
 
 /// How training collects experience, shared by `train` and `bench rl`. Eight environments
 /// on two threads balance physics against the 40 batches of a cycle on a 2-core machine.
@@ -121,7 +121,7 @@ pub struct TrainArgs {
     /// a factor drawn log-uniform between 1/(1+S) and 1+S from the episode's seed; the test
     /// episodes of each epoch are varied alike (0: the scene's own physics, as the paper). A
     /// resume must say it again.
-    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    #[arg(long, default_value_t = 0.0, value_name = "S", value_parser = physics_spread)]
     physics_spread: f64,
 }
 
@@ -323,12 +323,6 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
     } = args.workers;
     if envs == 0 || threads == 0 || args.epochs == 0 {
         bail!("--envs, --threads and --epochs must be at least 1");
-    }
-    if !(args.physics_spread >= 0.0 && args.physics_spread.is_finite()) {
-        bail!(
-            "--physics-spread must be 0 or more (0.3 scales each by 1/1.3 to 1.3), not {}",
-            args.physics_spread
-        );
     }
     if args.quarter_goals && matches!(args.choice.env, EnvKind::Rot) {
         bail!("--quarter-goals is for LayerOpEnv (train layer)");

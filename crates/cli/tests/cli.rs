@@ -168,19 +168,10 @@ fn eval_one_cube<'a>(distance: &'a str, out: &'a str) -> [&'a str; 10] {
 
 #[test]
 fn demo_narrates_the_hand_solving_with_the_shipped_policies() {
-    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let policies = shipped_policy_flags();
+    let demo = ["demo", "--distance", "1", "--seed", "3"];
     let o = dexcube(
-        &[
-            "demo",
-            "--distance",
-            "1",
-            "--seed",
-            "3",
-            "--rot-policy",
-            rot.to_str().unwrap(),
-            "--layer-policy",
-            layer.to_str().unwrap(),
-        ],
+        &[&demo[..], &policies.each_ref().map(String::as_str)].concat(),
         "",
     );
     let out = stdout(&o);
@@ -212,17 +203,11 @@ fn demo_without_policies_says_where_to_get_them() {
 fn eval_writes_its_table_and_a_rerun_continues_it() {
     let out = std::env::temp_dir().join("dexcube-cli-eval/table");
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
-    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let policies = shipped_policy_flags();
     let args = [
         &eval_one_cube("1", out.to_str().unwrap())[..],
-        &[
-            "--seed",
-            "5",
-            "--rot-policy",
-            rot.to_str().unwrap(),
-            "--layer-policy",
-            layer.to_str().unwrap(),
-        ],
+        &["--seed", "5"],
+        &policies.each_ref().map(String::as_str),
     ]
     .concat();
     let o = dexcube(&args, "");
@@ -1164,19 +1149,12 @@ fn eval_stage_writes_a_video_of_its_first_episode() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let video = dir.join("first.gif");
-    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let policies = shipped_policy_flags();
     let eval = [
-        "eval-stage",
-        "layer",
-        "--episodes",
-        "2",
-        "--threads",
-        "1",
-        "--rot-policy",
-        rot.to_str().unwrap(),
-        "--layer-policy",
-        layer.to_str().unwrap(),
-    ];
+        &["eval-stage", "layer", "--episodes", "2", "--threads", "1"][..],
+        &policies.each_ref().map(String::as_str),
+    ]
+    .concat();
     let o = dexcube(
         &[&eval[..], &["--video", video.to_str().unwrap()]].concat(),
         "",
