@@ -722,16 +722,6 @@ pub struct EvalStageArgs {
     /// run once more on its own, as it ran among the others, to watch what the hand did.
     #[arg(long, value_name = "FILE")]
     video: Option<PathBuf>,
-    /// Once the paper's test has held N control steps running, the hand keeps its last
-    /// action's targets for the rest of the episode instead of acting on: a stage that stops
-    /// once it has done its job, judged at the episode's end as any other.
-    #[arg(long, value_name = "N")]
-    hold_after: Option<usize>,
-    /// Once, at control step K, if the paper's test is not met the hand opens (to flat, then
-    /// the neutral pose, 10 steps each, as the operator opens it before a stage) and the
-    /// policy acts again from there, within the same episode.
-    #[arg(long, value_name = "K")]
-    retry_after: Option<usize>,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -822,43 +812,15 @@ fn episode(
     seed: u64,
     thresholds: (f64, f64),
     record: bool,
-    hold_after: Option<usize>,
-    retry_after: Option<usize>,
     watch: &mut dyn FnMut(&mut Sim),
 ) -> EpisodeTrace {
     let (mut obs, _) = env.reset(Some(seed));
     let start = record.then(|| env.fresh_start());
     let puzzle_at_start = read_puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
-    let mut kept: Option<Vec<f64>> = None;
-    let release = std::env::var("DEXCUBE_HOLD_RELEASE").is_ok();
     watch(env.sim_mut());
-    let (mut step, mut opening): (usize, Option<(Vec<f64>, usize)>) = (0, None);
-    let retry_steps: usize = std::env::var("DEXCUBE_RETRY_STEPS").map_or(10, |s| s.parse().unwrap());
     loop {
-        step += 1;
-        if retry_after == Some(step - 1) && hold == 0 {
-            opening = Some((env.sim().action().to_vec(), 0));
-        }
-        let open_action = opening.as_mut().and_then(|(from, i)| {
-            *i += 1;
-            let open = env.sim().scene().open_hand_action();
-            if *i > 2 * retry_steps {
-                return None;
-            }
-            let t = (*i as f64 / retry_steps as f64).min(1.0);
-            Some(if *i > retry_steps {
-                vec![0.0; from.len()]
-            } else {
-                from.iter().zip(&open).map(|(a, b)| a + t * (b - a)).collect()
-            })
-        });
-        let action = match (&kept, open_action) {
-            (_, Some(action)) => action,
-            (Some(action), None) => action.clone(),
-            (None, None) => policy.act(&obs.observation, &obs.desired_goal),
-        };
-        let t = env.step(&action);
+        let t = env.step(&policy.act(&obs.observation, &obs.desired_goal));
         watch(env.sim_mut());
         hold = if meets_paper_test(&t.info, thresholds) {
             hold + 1
@@ -866,12 +828,6 @@ fn episode(
             0
         };
         longest_hold = longest_hold.max(hold);
-        if release && hold == 0 {
-            kept = None;
-        }
-        if kept.is_none() && hold_after.is_some_and(|steps| hold >= steps) {
-            kept = Some(action);
-        }
         if t.terminated || t.truncated {
             return EpisodeTrace {
                 square: is_square(env.sim()),
@@ -960,8 +916,6 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 episode_seed(k),
                 thresholds,
                 keep_starts,
-                args.hold_after,
-                args.retry_after,
                 &mut |_| {},
             );
             let turning = args.stage == EnvKind::Layer;
@@ -1010,8 +964,6 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             episode_seed(0),
             thresholds,
             false,
-            args.hold_after,
-            args.retry_after,
             watch,
         );
         video.save()?;
@@ -1046,9 +998,6 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     }
     if args.physics_spread > 0.0 {
         from += &format!(", physics varied by spread {}", args.physics_spread);
-    }
-    if let Some(steps) = args.hold_after {
-        from += &format!(", the hand keeping its targets once the goal held {steps} step(s)");
     }
     println!(
         "{what}: {wins}/{episodes} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), {from}, policy {}",
