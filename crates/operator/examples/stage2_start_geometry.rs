@@ -10,9 +10,11 @@
 //! With `--mark-side SIDE OUT` (SIDE one of x-, x+, y-, y+) it also writes the starts, joined,
 //! to OUT with every start on that side of the resting point marked as failed beside those
 //! the recorded policy failed from, so that `dexcube train --starts OUT --failed-weight W`
-//! draws that side W times as often.
+//! draws that side W times as often. With `--only-side SIDE OUT` it writes only the starts on
+//! that side, their marks as recorded: a run that trains there alone (`--start-share 1`), or
+//! an evaluation of that side alone (`dexcube eval-stage layer --starts OUT`).
 //!
-//! `cargo run --release -p dexcube-operator --example stage2_start_geometry -- [--mark-side SIDE OUT] STARTS...`
+//! `cargo run --release -p dexcube-operator --example stage2_start_geometry -- [--mark-side|--only-side SIDE OUT] STARTS...`
 
 use std::path::Path;
 
@@ -55,20 +57,22 @@ fn on_side(offset: [f64; 2], side: [f64; 2]) -> bool {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let usage = "usage: stage2_start_geometry [--mark-side x-|x+|y-|y+ OUT] STARTS...";
+    let usage = "usage: stage2_start_geometry [--mark-side|--only-side x-|x+|y-|y+ OUT] STARTS...";
     let mut paths: Vec<String> = std::env::args().skip(1).collect();
-    let mark = match paths.first().map(String::as_str) {
-        Some("--mark-side") if paths.len() > 3 => {
+    let flag = paths.first().cloned().unwrap_or_default();
+    let mark = match flag.as_str() {
+        "--mark-side" | "--only-side" if paths.len() > 3 => {
+            let only = flag == "--only-side";
             let out = paths.remove(2);
             let name = paths.remove(1);
             paths.remove(0);
             let side = SIDES
                 .iter()
                 .find(|(tag, _, _)| *tag == name)
-                .ok_or(format!("--mark-side takes x-, x+, y- or y+, not '{name}'"))?;
-            Some((side, out))
+                .ok_or(format!("{flag} takes x-, x+, y- or y+, not '{name}'"))?;
+            Some((side, only, out))
         }
-        Some("--mark-side") => return Err(usage.into()),
+        "--mark-side" | "--only-side" => return Err(usage.into()),
         _ => None,
     };
     if paths.is_empty() {
@@ -94,10 +98,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .expect("three faces");
             let yaw = side[1].atan2(side[0]).to_degrees().rem_euclid(90.0);
             let offset = [0, 1].map(|k| 1000.0 * (pose.position[k] - resting[k]));
-            if let Some(((_, _, side), _)) = &mark {
+            if let Some(((_, _, side), only, _)) = &mark {
+                let there = on_side(offset, *side);
                 let mut start = start.clone();
-                start.failed |= on_side(offset, *side);
-                marked.push(start);
+                if !only {
+                    start.failed |= there;
+                }
+                if there || !only {
+                    marked.push(start);
+                }
             }
             starts.push(Start {
                 yaw: yaw.min(90.0 - yaw),
@@ -128,10 +137,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let there = count(&|s| on_side(s.offset, side));
         println!("  {name}: {there}");
     }
-    if let (Some(((tag, _, _), out)), Some(mut origin)) = (mark, first_origin) {
+    if let (Some(((tag, _, _), only, out)), Some(mut origin)) = (mark, first_origin) {
+        let flag = if only { "--only-side" } else { "--mark-side" };
         origin.command = format!(
             "cargo run --release -p dexcube-operator --example stage2_start_geometry -- \
-             --mark-side {tag} {out} {} (the first's command: {})",
+             {flag} {tag} {out} {} (the first's command: {})",
             paths.join(" "),
             origin.command
         );
