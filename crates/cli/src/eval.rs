@@ -722,6 +722,11 @@ pub struct EvalStageArgs {
     /// run once more on its own, as it ran among the others, to watch what the hand did.
     #[arg(long, value_name = "FILE")]
     video: Option<PathBuf>,
+    /// Also write one CSV row per episode: its number, seed (or recorded start), ending,
+    /// final position and angle errors, whether the cube ended square and with a layer
+    /// turned, and its longest run of steps at the goal.
+    #[arg(long, value_name = "FILE.csv")]
+    episodes_csv: Option<PathBuf>,
 }
 
 /// How an episode of one atomic action ended: success, or the reason it missed.
@@ -751,6 +756,19 @@ impl Ending {
         Ending::NeverTurned,
         Ending::Jammed,
     ];
+
+    /// The ending's name in a CSV column.
+    fn tag(self) -> &'static str {
+        match self {
+            Ending::Success => "success",
+            Ending::Dropped => "dropped",
+            Ending::PositionOff => "position_off",
+            Ending::AngleOff => "angle_off",
+            Ending::BothOff => "both_off",
+            Ending::NeverTurned => "never_turned",
+            Ending::Jammed => "jammed",
+        }
+    }
 
     fn name(self) -> &'static str {
         match self {
@@ -891,6 +909,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         s[..episodes].iter().filter(|start| start.failed).count()
     });
     let failures_again = AtomicUsize::new(0);
+    let rows = Mutex::new(Vec::new());
     let (keep_starts, recorded) = (
         args.record_starts.is_some(),
         std::sync::Mutex::new(Vec::new()),
@@ -943,6 +962,19 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     successes_with_layer_turns.fetch_add(1, Ordering::Relaxed);
                 }
             }
+            if args.episodes_csv.is_some() {
+                let row = format!(
+                    "{k},{},{},{:.6},{:.6},{},{},{}",
+                    episode_seed(k),
+                    ending.tag(),
+                    trace.info.position_error,
+                    trace.info.angle_error,
+                    trace.square,
+                    trace.turned_a_layer,
+                    trace.longest_hold
+                );
+                rows.lock().expect("no thread panics").push((k, row));
+            }
             for (count, steps) in held.iter().zip(HOLDS) {
                 if trace.longest_hold >= steps {
                     count.fetch_add(1, Ordering::Relaxed);
@@ -953,6 +985,19 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         },
     )?;
     bar.finish_and_clear();
+    if let Some(path) = &args.episodes_csv {
+        let mut rows = rows.into_inner().expect("no thread panics");
+        rows.sort_by_key(|(k, _)| *k);
+        let mut text = String::from(
+            "episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold\n",
+        );
+        for (_, row) in rows {
+            text += &row;
+            text.push('\n');
+        }
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("writing the episodes' rows to {}", path.display()))?;
+    }
     if let Some(path) = &args.video {
         let policy = Policy::load(&prefix, &burn::prelude::Device::flex())?;
         let mut env = setup.env(&policy, numbered(&starts))?;

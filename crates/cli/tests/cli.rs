@@ -120,6 +120,14 @@ fn scramble_is_reproducible_and_its_output_solves_at_that_distance() {
 }
 
 /// The repository's models folder, which the demo and the evaluation use.
+/// An empty directory of this name under the system's temporary directory.
+fn fresh_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 fn models() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
 }
@@ -1018,9 +1026,7 @@ fn eval_stage_runs_a_policy_at_another_rate_or_physics_and_records_only_its_own(
 /// arguments and a missing teacher fail cleanly.
 #[test]
 fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
-    let dir = std::env::temp_dir().join("dexcube-cli-distil");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = fresh_dir("dexcube-cli-distil");
     let (rot, layer) = (models().join("rot"), models().join("layer"));
     let (rot, layer) = (rot.to_str().unwrap(), layer.to_str().unwrap());
     let out = dir.join("student");
@@ -1145,9 +1151,7 @@ fn distil_writes_a_single_student_eval_stage_runs_and_one_row_per_round() {
 /// for each control step, and counts the episodes as it would without one.
 #[test]
 fn eval_stage_writes_a_video_of_its_first_episode() {
-    let dir = std::env::temp_dir().join("dexcube-cli-eval-stage-video");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = fresh_dir("dexcube-cli-eval-stage-video");
     let video = dir.join("first.gif");
     let policies = shipped_policy_flags();
     let eval = [
@@ -1171,5 +1175,48 @@ fn eval_stage_writes_a_video_of_its_first_episode() {
         stdout(&o).lines().next(),
         stdout(&without).lines().next(),
         "the same count"
+    );
+}
+
+/// `eval-stage --episodes-csv` writes one row per episode, in order, whose endings add up to
+/// the count it prints, and whose errors agree with each ending.
+#[test]
+fn eval_stage_writes_a_row_per_episode() {
+    let dir = fresh_dir("dexcube-cli-eval-stage-episodes");
+    let csv = dir.join("episodes.csv");
+    let policies = shipped_policy_flags();
+    let args = [
+        &["eval-stage", "layer", "--episodes", "3", "--threads", "2"][..],
+        &["--seed", "8000014", "--episodes-csv", csv.to_str().unwrap()],
+        &policies.each_ref().map(String::as_str),
+    ]
+    .concat();
+    let o = dexcube(&args, "");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|line| line.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3);
+    let mut successes = 0;
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], k.to_string());
+        assert_eq!(row[1], (8_000_014 + k).to_string());
+        let angle_error: f64 = row[4].parse().unwrap();
+        let longest_hold: usize = row[7].parse().unwrap();
+        if row[2] == "success" {
+            successes += 1;
+            assert!(angle_error < 0.1 && longest_hold >= 1, "{row:?}");
+        } else {
+            assert!(angle_error >= 0.1 || row[2] == "dropped", "{row:?}");
+        }
+    }
+    assert!(
+        stdout(&o).contains(&format!(": {successes}/3 = ")),
+        "{}",
+        stdout(&o)
     );
 }
