@@ -119,7 +119,6 @@ fn scramble_is_reproducible_and_its_output_solves_at_that_distance() {
     }
 }
 
-/// The repository's models folder, which the demo and the evaluation use.
 /// An empty directory of this name under the system's temporary directory.
 fn fresh_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(name);
@@ -128,6 +127,7 @@ fn fresh_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
+/// The repository's models folder, which the demo and the evaluation use.
 fn models() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
 }
