@@ -847,30 +847,6 @@ fn episode(
         };
         longest_hold = longest_hold.max(hold);
         if t.terminated || t.truncated {
-            if std::env::var("DEXCUBE_OPEN_AFTER").is_ok() && !t.info.dropped {
-                // Prototype: the hand opens as the operator opens it (to flat, then neutral,
-                // 10 steps each), and the test is read once more with the cube at rest.
-                let from = env.sim().action().to_vec();
-                let open = env.sim().scene().open_hand_action();
-                let mut last = t.info.clone();
-                for i in 1..=20 {
-                    let a: Vec<f64> = if i > 10 {
-                        vec![0.0; from.len()]
-                    } else {
-                        let f = i as f64 / 10.0;
-                        from.iter().zip(&open).map(|(a, b)| a + f * (b - a)).collect()
-                    };
-                    last = env.step(&a).info;
-                }
-                eprintln!(
-                    "opened {seed} {} {} {:.4} {:.4} {}",
-                    meets_paper_test(&t.info, thresholds),
-                    meets_paper_test(&last, thresholds) && !last.dropped,
-                    t.info.angle_error,
-                    last.angle_error,
-                    is_square(env.sim())
-                );
-            }
             return EpisodeTrace {
                 square: is_square(env.sim()),
                 turned_a_layer: turned_since(puzzle_at_start.as_ref(), env.sim()),
