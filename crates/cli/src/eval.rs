@@ -548,8 +548,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
     done?;
     let results = shared.into_inner().expect("lock");
     save(&results)?;
-    let mut recorded = recorded.into_inner().expect("lock");
-    recorded.sort_by_key(|(k, _)| *k);
+    let mut recorded = in_episode_order(recorded);
     let record_flags: String = recording
         .iter()
         .filter_map(|(stage, path)| {
@@ -561,7 +560,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         let Some(path) = path else { continue };
         let starts: Vec<_> = recorded
             .iter_mut()
-            .flat_map(|(_, s)| std::mem::take(&mut s[stage_index]))
+            .flat_map(|s| std::mem::take(&mut s[stage_index]))
             .collect();
         let (name, failure) = (stage.stage(), stage.recorded_failure());
         if starts.is_empty() {
@@ -624,6 +623,13 @@ pub(crate) fn in_parallel<S>(
                 .map_err(|_| anyhow::anyhow!("an evaluation thread panicked"))?
         })
     })
+}
+
+/// What `in_parallel`'s work gathered as (k, item), in the order of k.
+fn in_episode_order<T>(gathered: Mutex<Vec<(usize, T)>>) -> Vec<T> {
+    let mut gathered = gathered.into_inner().expect("no thread panics");
+    gathered.sort_by_key(|(k, _)| *k);
+    gathered.into_iter().map(|(_, item)| item).collect()
 }
 
 /// A 64-bit FNV-1a fingerprint of a file's bytes.
@@ -910,10 +916,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     });
     let failures_again = AtomicUsize::new(0);
     let rows = Mutex::new(Vec::new());
-    let (keep_starts, recorded) = (
-        args.record_starts.is_some(),
-        std::sync::Mutex::new(Vec::new()),
-    );
+    let (keep_starts, recorded) = (args.record_starts.is_some(), Mutex::new(Vec::new()));
     // Episode k begins from recorded start k, or from a fresh placement seeded seed + k.
     let episode_seed = |k: usize| match starts {
         Some(_) => k as u64,
@@ -986,15 +989,11 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     )?;
     bar.finish_and_clear();
     if let Some(path) = &args.episodes_csv {
-        let mut rows = rows.into_inner().expect("no thread panics");
-        rows.sort_by_key(|(k, _)| *k);
-        let mut text = String::from(
-            "episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold\n",
-        );
-        for (_, row) in rows {
-            text += &row;
-            text.push('\n');
-        }
+        let header =
+            "episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold";
+        let mut lines = vec![header.to_string()];
+        lines.extend(in_episode_order(rows));
+        let text = lines.join("\n") + "\n";
         write_atomically(path, text.as_bytes())
             .with_context(|| format!("writing the episodes' rows to {}", path.display()))?;
     }
@@ -1081,9 +1080,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if let Some(path) = &args.record_starts {
-        let mut recorded = recorded.into_inner().expect("no thread panics");
-        recorded.sort_by_key(|(k, _)| *k);
-        let starts: Vec<_> = recorded.into_iter().map(|(_, start)| start).collect();
+        let starts = in_episode_order(recorded);
         let origin = StartsOrigin {
             stage: args.stage.name().to_string(),
             failure,

@@ -137,8 +137,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let there = count(&|s| on_side(s.offset, side));
         println!("  {name}: {there}");
     }
-    if let (Some(((tag, _, _), only, out)), Some(mut origin)) = (mark, first_origin) {
-        let flag = if only { "--only-side" } else { "--mark-side" };
+    if let (Some(((tag, _, _), _, out)), Some(mut origin)) = (mark, first_origin) {
         origin.command = format!(
             "cargo run --release -p dexcube-operator --example stage2_start_geometry -- \
              {flag} {tag} {out} {} (the first's command: {})",
