@@ -12,7 +12,7 @@ use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
-use crate::env::{EnvChoice, EnvKind, physics_spread, starts_for};
+use crate::env::{EnvChoice, EnvKind, PAPER_ANGLE_THRESHOLD, physics_spread, starts_for};
 
 /// How training collects experience, shared by `train` and `bench rl`. Eight environments
 /// on two threads balance physics against the 40 batches of a cycle on a 2-core machine.
@@ -255,9 +255,10 @@ pub fn guide(args: GuideArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Refuses to resume a run with other recorded starts, at another control rate, or under
-/// other varied physics than it began with (its checkpoint's card names them), since the
-/// card would then say it trained on starts, at a rate or on physics it did not.
+/// Refuses to resume a run with other recorded starts, at another control rate, under other
+/// varied physics or to another angle threshold than it began with (its checkpoint's card
+/// names them), since the card would then say it trained on starts, at a rate, on physics
+/// or to a test it did not.
 fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {
     // A missing or unreadable checkpoint is the trainer's to report.
     let Ok(begun) = dexcube_rl::train::RunCurve::read(run) else {
@@ -303,14 +304,24 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
             args.choice.control_rate
         );
     }
-    // Runs from before physics could be varied ran on the scene's own.
-    let begun_spread = environment["physics_spread"].as_f64().unwrap_or(0.0);
-    if begun_spread != args.physics_spread {
-        bail!(
-            "{} began with --physics-spread {begun_spread}; resume it with the same, not {}",
-            run.display(),
-            args.physics_spread
-        );
+    // Runs from before physics could be varied ran on the scene's own, and runs from before
+    // the threshold could be chosen trained to the paper's.
+    for (key, flag, given, before) in [
+        ("physics_spread", "--physics-spread", args.physics_spread, 0.0),
+        (
+            "angle_threshold",
+            "--angle-threshold",
+            args.choice.angle_threshold,
+            PAPER_ANGLE_THRESHOLD,
+        ),
+    ] {
+        let begun = environment[key].as_f64().unwrap_or(before);
+        if begun != given {
+            bail!(
+                "{} began with {flag} {begun}; resume it with the same, not {given}",
+                run.display()
+            );
+        }
     }
     Ok(())
 }
@@ -463,6 +474,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "failed_weight": args.starts.as_ref().map(|_| args.failed_weight),
             "control_substeps": rate.substeps(),
             "physics_spread": args.physics_spread,
+            "angle_threshold": args.choice.angle_threshold,
         }),
     };
     eprintln!(
