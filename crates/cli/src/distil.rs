@@ -105,6 +105,14 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let teacher = Policy::load(&setup.prefix, &Device::flex())?;
+    if teacher.card.goal_lead.is_some() {
+        bail!(
+            "{} is shown its goal led on, which a student shown the goal itself cannot learn \
+             from its actions: distil the policy it was made from (its card's metadata.led \
+             names it)",
+            setup.prefix.display()
+        );
+    }
     let starts = match &args.starts {
         None => None,
         Some(path) => Some(StartMix {

@@ -374,9 +374,11 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
         (true, false) => ", every cubelet within 0.1 rad of a quarter turn",
         (false, false) => "",
     };
+    let angle = choice.angle_threshold;
     match choice.env {
         EnvKind::Rot => println!(
-            "  success:     position within 0.01 m and {} within 0.1 rad{square}; reward 0, else -1",
+            "  success:     position within 0.01 m and {} within {angle} rad{square}; reward 0, \
+             else -1",
             match choice.mode {
                 RotMode::Paper => "orientation",
                 RotMode::Axis => "the target's up axis",
@@ -384,7 +386,7 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
             }
         ),
         EnvKind::Layer => println!(
-            "  success:     layer angle within 0.1 rad of the goal{square}; reward 0, else -1"
+            "  success:     layer angle within {angle} rad of the goal{square}; reward 0, else -1"
         ),
     }
     Ok(ExitCode::SUCCESS)

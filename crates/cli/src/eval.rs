@@ -843,13 +843,10 @@ fn episode(
     let puzzle_at_start = read_puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
     watch(env.sim_mut());
-    let bias = goal_bias();
+    let test = env.goal();
     loop {
-        let goal = match bias {
-            Some((alpha, cap)) => biased_goal(&obs.achieved_goal, &obs.desired_goal, alpha, cap),
-            None => obs.desired_goal.clone(),
-        };
-        let t = env.step(&policy.act(&obs.observation, &goal));
+        let goals = (&obs.achieved_goal[..], &obs.desired_goal[..]);
+        let t = env.step(&policy.act_toward(&obs.observation, goals, test.as_ref()));
         watch(env.sim_mut());
         hold = if meets_paper_test(&t.info, thresholds) {
             hold + 1
@@ -868,57 +865,6 @@ fn episode(
         }
         obs = t.observation;
     }
-}
-
-/// Prototype: DEXCUBE_GOAL_BIAS=ALPHA (and DEXCUBE_GOAL_BIAS_CAP=RAD, default 0.5) shows
-/// the policy a goal ALPHA times its error further on whenever its angle error is under CAP.
-fn goal_bias() -> Option<(f64, f64)> {
-    let alpha = std::env::var("DEXCUBE_GOAL_BIAS").ok()?.parse().ok()?;
-    let cap = std::env::var("DEXCUBE_GOAL_BIAS_CAP")
-        .ok()
-        .and_then(|t| t.parse().ok())
-        .unwrap_or(0.5);
-    Some((alpha, cap))
-}
-
-/// The desired goal moved `alpha` times its error further on, when that error is under `cap`:
-/// a layer angle (goal of 1 or 2), or a pose (7 or 8) judged by its up axis (axis and pair
-/// modes) and its position.
-fn biased_goal(achieved: &[f64], desired: &[f64], alpha: f64, cap: f64) -> Vec<f64> {
-    use dexcube_sim::rotation::{about, conj, mul, normalise, rotate};
-    let mut goal = desired.to_vec();
-    if desired.len() <= 2 {
-        let error = desired[0] - achieved[0];
-        if error.abs() < cap {
-            goal[0] += alpha * error;
-        }
-        return goal;
-    }
-    let (a, d) = (
-        [achieved[3], achieved[4], achieved[5], achieved[6]],
-        [desired[3], desired[4], desired[5], desired[6]],
-    );
-    let up = rotate(&conj(&d), [0.0, 0.0, 1.0]);
-    let now = rotate(&a, up);
-    let target = [0.0, 0.0, now[2].signum()];
-    let angle = (now[2].abs()).clamp(-1.0, 1.0).acos();
-    if angle >= cap || angle < 1e-9 {
-        return goal;
-    }
-    let cross = [
-        now[1] * target[2] - now[2] * target[1],
-        now[2] * target[0] - now[0] * target[2],
-        now[0] * target[1] - now[1] * target[0],
-    ];
-    let norm = cross.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let axis = cross.map(|x| x / norm);
-    let turn = mul(&mul(&conj(&a), &about(axis, alpha * angle)), &a);
-    let q = normalise(&mul(&d, &turn));
-    goal[3..7].copy_from_slice(&q);
-    for k in 0..3 {
-        goal[k] += alpha * (desired[k] - achieved[k]);
-    }
-    goal
 }
 
 /// Holds of at least this many control steps are counted in `eval-stage`'s report: what a

@@ -47,6 +47,11 @@ enum Command {
     /// a few near it, the one they value most (the smaller of TD3's two values). Writes a
     /// policy that loads and runs as any other.
     Guide(train::GuideArgs),
+    /// Shows a policy its goal led on past the one it is judged by: once the angle still to
+    /// go is small, a share of what is still to go is added to it, as a controller's integral
+    /// term adds to an error that persists. Writes a policy that loads and runs as any other;
+    /// its weights are unchanged.
+    GoalLead(train::GoalLeadArgs),
     /// Teaches one actor to act as a stage policy does (an ensemble, typically) by DAgger:
     /// the teacher labels every state of episodes run first by itself, then by the student.
     Distil(distil::DistilArgs),
@@ -80,6 +85,7 @@ fn main() -> ExitCode {
         Command::Average(args) => train::combine(train::Combination::Average, args),
         Command::Ensemble(args) => train::combine(train::Combination::Ensemble, args),
         Command::Guide(args) => train::guide(args),
+        Command::GoalLead(args) => train::goal_lead(args),
         Command::Distil(args) => distil::run(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),

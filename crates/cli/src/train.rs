@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::{LayerGoals, LayerMove};
-use dexcube_env::{ControlRate, CubeRotEnv, LayerOpEnv, StartMix, StartPick};
+use dexcube_env::{ControlRate, CubeRotEnv, GoalLead, LayerOpEnv, StartMix, StartPick};
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
@@ -255,6 +255,66 @@ pub fn guide(args: GuideArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+#[derive(Args)]
+pub struct GoalLeadArgs {
+    /// The policy to lead (a single one, an ensemble or a guided one), as the path of its
+    /// .safetensors and .json less the extension.
+    policy: PathBuf,
+    /// The share of the angle (and for a pose, the distance) still to go that is added to the
+    /// goal the policy is shown.
+    #[arg(long, value_name = "SHARE", value_parser = lead_share)]
+    share: f64,
+    /// Only while the angle still to go is under this many radians; further off, the policy is
+    /// shown its goal as it is.
+    #[arg(long, default_value_t = 0.5, value_name = "RAD", value_parser = lead_within)]
+    within: f64,
+    /// Where to write the result (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn lead_share(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(share) if share > 0.0 && share.is_finite() => Ok(share),
+        _ => Err(format!(
+            "--share must be a positive number (0.5 shows the goal half its error further on), \
+             not '{text}'"
+        )),
+    }
+}
+
+fn lead_within(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(within) if within > 0.0 && within < std::f64::consts::PI => Ok(within),
+        _ => Err(format!(
+            "--within must be an angle in radians above 0 and below π, not '{text}'"
+        )),
+    }
+}
+
+pub fn goal_lead(args: GoalLeadArgs) -> anyhow::Result<ExitCode> {
+    let command = format!(
+        "dexcube goal-lead {} --share {} --within {} --out {}",
+        args.policy.display(),
+        args.share,
+        args.within,
+        args.out.display()
+    );
+    let lead = GoalLead {
+        share: args.share,
+        within: args.within,
+    };
+    Policy::led(&args.policy, lead, &args.out, &command)?;
+    println!(
+        "{} shown its goal led on by {} within {} rad into {}",
+        args.policy.display(),
+        args.share,
+        args.within,
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Refuses to resume a run with other recorded starts, at another control rate, under other
 /// varied physics or to another angle threshold than it began with (its checkpoint's card
 /// names them), since the card would then say it trained on starts, at a rate, on physics
@@ -307,7 +367,12 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
     // Runs from before physics could be varied ran on the scene's own, and runs from before
     // the threshold could be chosen trained to the paper's.
     for (key, flag, given, before) in [
-        ("physics_spread", "--physics-spread", args.physics_spread, 0.0),
+        (
+            "physics_spread",
+            "--physics-spread",
+            args.physics_spread,
+            0.0,
+        ),
         (
             "angle_threshold",
             "--angle-threshold",

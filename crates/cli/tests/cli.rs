@@ -485,6 +485,20 @@ fn each_environment_takes_only_objects_it_can_hold() {
         let args = [&["env", "info"][..], other, &["--square"]].concat();
         assert_clean_failure(&dexcube(&args, ""), 2, "--square is for the physical cube");
     }
+    // A tighter training threshold is the success test's, and names the environment.
+    for (env, test) in [
+        ("rot", "orientation within 0.05 rad"),
+        ("layer", "angle within 0.05 rad"),
+    ] {
+        let tight = dexcube(&["env", "info", env, "--angle-threshold", "0.05"], "");
+        assert!(
+            tight.status.success()
+                && stdout(&tight).contains(test)
+                && stdout(&tight).contains("trained to 0.05 rad)"),
+            "{}",
+            stdout(&tight)
+        );
+    }
 }
 
 /// Settings a training run cannot use are refused before it starts, each with its reason.
@@ -546,6 +560,14 @@ fn train_refuses_settings_it_cannot_run() {
         (
             &["rot", "--physics-spread=-0.1"],
             "--physics-spread must be 0 or more",
+        ),
+        (
+            &["rot", "--angle-threshold", "0"],
+            "--angle-threshold must be an angle in radians above 0",
+        ),
+        (
+            &["layer", "--angle-threshold", "4"],
+            "--angle-threshold must be an angle in radians above 0",
         ),
         (
             &["layer", "--object", "cube", "--intact"],
@@ -730,6 +752,14 @@ fn train_resumes_only_with_the_starts_the_rate_and_the_physics_it_began_with() {
         ),
         2,
         "began with --physics-spread 0; resume it with the same, not 0.3",
+    );
+    assert_clean_failure(
+        &resume(
+            "rot-pair-cube-square-anchor5-seed0",
+            &["--angle-threshold", "0.05"],
+        ),
+        2,
+        "began with --angle-threshold 0.1; resume it with the same, not 0.05",
     );
 }
 
@@ -1219,4 +1249,47 @@ fn eval_stage_writes_a_row_per_episode() {
         "{}",
         stdout(&o)
     );
+}
+
+/// `goal-lead` writes a policy that `eval-stage` runs shown its goal led on, which a single
+/// episode tells from the policy it was made from; bad settings and combining it are refused.
+#[test]
+fn a_policy_led_on_runs_on_the_goal_led_on() {
+    let dir = fresh_dir("dexcube-cli-goal-lead");
+    std::fs::create_dir_all(&dir).unwrap();
+    let layer = models().join("layer");
+    let layer = layer.to_str().unwrap();
+    let led = dir.join("layer-led");
+    let led = led.to_str().unwrap();
+    let o = dexcube(&["goal-lead", layer, "--share", "0.5", "--out", led], "");
+    assert!(
+        o.status.success() && stdout(&o).contains("led on by 0.5 within 0.5 rad"),
+        "{}",
+        stderr(&o)
+    );
+    let row = |policy: &str| {
+        let csv = dir.join("episodes.csv");
+        let args = [
+            &["eval-stage", "layer", "--episodes", "1", "--threads", "1"][..],
+            &["--seed", "8000014", "--episodes-csv", csv.to_str().unwrap()],
+            &["--layer-policy", policy],
+        ]
+        .concat();
+        let o = dexcube(&args, "");
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read_to_string(&csv).unwrap()
+    };
+    assert_ne!(row(layer), row(led), "the same episode, acted otherwise");
+    for (flags, says) in [
+        (&["--share", "0"][..], "--share must be a positive number"),
+        (
+            &["--share", "0.5", "--within", "4"],
+            "--within must be an angle",
+        ),
+    ] {
+        let args = [&["goal-lead", layer, "--out", led][..], flags].concat();
+        assert_clean_failure(&dexcube(&args, ""), 2, says);
+    }
+    let joined = dexcube(&["ensemble", led, layer, "--out", led], "");
+    assert_clean_failure(&joined, 2, "shown its goal led on (by 0.5 within 0.5 rad)");
 }

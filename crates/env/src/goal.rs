@@ -1,11 +1,13 @@
 //! What counts as success, as pure functions of an achieved and a desired goal, so that
 //! Hindsight Experience Replay can relabel goals through them without an environment. An
-//! environment's `step` uses the same functions, so the two always agree.
+//! environment's `step` uses the same functions, so the two always agree. Also how a goal is
+//! led on past where it lies ([`GoalLead`]), which a deployed policy may be shown instead.
 
 use std::f64::consts::PI;
 
 use dexcube_sim::cube::ALIGNED_TOLERANCE;
 use dexcube_sim::rotation;
+use serde::{Deserialize, Serialize};
 
 /// A goal space: its size, the success test, and the errors `info` reports.
 pub trait Goal: Send + Sync {
@@ -25,6 +27,25 @@ pub trait Goal: Send + Sync {
             -1.0
         }
     }
+
+    /// The goal `desired` led on past where it lies, as `lead` says, for an object whose goal
+    /// is now `achieved`. A goal space with no way on shows `desired` as it is.
+    fn led(&self, achieved: &[f64], desired: &[f64], lead: GoalLead) -> Vec<f64> {
+        let _ = (achieved, lead);
+        desired.to_vec()
+    }
+}
+
+/// A goal shown to a policy further on than the one it is judged by: once the angle still to
+/// go is under `within` radians, `share` times what is still to go is added to it (for a pose,
+/// its position too), as a controller's integral term adds to an error that persists. A
+/// policy trained to the paper's threshold is rewarded as much a few degrees short of its
+/// goal as on it, and may settle there; shown the goal further on, it goes on. The success
+/// test still reads the goal itself. Session 40 in `results/TRAINING.md` measures it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GoalLead {
+    pub share: f64,
+    pub within: f64,
 }
 
 /// How CubeRotEnv judges orientation.
@@ -185,6 +206,68 @@ impl Goal for RotGoal {
             && angle < self.angle_threshold
             && leaves_square(self.square_threshold, achieved)
     }
+
+    /// The pose led on: its orientation turned on past the target by `share` times the turn
+    /// still to go, about that turn's own axis (in axis and pair modes, the turn that brings
+    /// the target's up axis up, either way up in pair mode), and its position moved on alike.
+    fn led(&self, achieved: &[f64], desired: &[f64], lead: GoalLead) -> Vec<f64> {
+        let (a, d) = (quat(achieved), quat(desired));
+        let Some(turn) = self.turn_to_go(&a, &d) else {
+            return desired.to_vec();
+        };
+        let (axis, angle) = turn;
+        if angle >= lead.within {
+            return desired.to_vec();
+        }
+        let on = rotation::about(axis, lead.share * angle);
+        let orientation = match self.mode {
+            // The world turn that takes the cube on, before the target.
+            RotMode::Paper => rotation::mul(&on, &d),
+            // The same turn expressed in the cube's frame, after the target, so that the
+            // target's up axis, seen where the cube now holds it, lies further from up.
+            RotMode::Axis | RotMode::Pair => rotation::mul(
+                &d,
+                &rotation::mul(&rotation::mul(&rotation::conj(&a), &on), &a),
+            ),
+        };
+        let mut goal = desired.to_vec();
+        goal[3..POSE_GOAL].copy_from_slice(&rotation::normalise(&orientation));
+        for k in 0..3 {
+            goal[k] += lead.share * (desired[k] - achieved[k]);
+        }
+        goal
+    }
+}
+
+impl RotGoal {
+    /// The world turn still to go from orientation `a` to the target `d` as this test reads
+    /// it, as a unit axis and an angle: turning `a` by the angle about the axis meets the
+    /// test exactly. In axis and pair modes it is the turn that brings the cube axis the
+    /// target holds up (either way up in pair mode) up. `None` when there is none to speak of.
+    fn turn_to_go(&self, a: &rotation::Quat, d: &rotation::Quat) -> Option<([f64; 3], f64)> {
+        let (axis, angle) = match self.mode {
+            RotMode::Paper => {
+                let e = rotation::mul(d, &rotation::conj(a));
+                let e = if e[0] < 0.0 { e.map(|x| -x) } else { e };
+                let angle = rotation::angle_between(a, d);
+                ([e[1], e[2], e[3]], angle)
+            }
+            RotMode::Axis | RotMode::Pair => {
+                let up = rotation::rotate(&rotation::conj(d), [0.0, 0.0, 1.0]);
+                let now = rotation::rotate(a, up);
+                let target_z = if self.mode == RotMode::Pair {
+                    now[2].signum()
+                } else {
+                    1.0
+                };
+                let angle = (now[2] * target_z).clamp(-1.0, 1.0).acos();
+                // now × target: about it, `now` turns towards the target.
+                ([now[1] * target_z, -now[0] * target_z, 0.0], angle)
+            }
+        };
+        let norm = axis.iter().map(|x| x * x).sum::<f64>().sqrt();
+        (angle > 1e-9 && norm > 1e-12).then(|| (axis.map(|x| x / norm), angle))
+    }
 }
 
 /// LayerOpEnv's goal: the angle between the two layers (1), and, when the success test also
@@ -253,6 +336,16 @@ impl Goal for LayerGoal {
     fn is_success(&self, achieved: &[f64], desired: &[f64]) -> bool {
         self.errors(achieved, desired).1 < self.angle_threshold
             && leaves_square(self.square_threshold, achieved)
+    }
+
+    /// The layer's goal angle moved on by `share` times the angle still to go.
+    fn led(&self, achieved: &[f64], desired: &[f64], lead: GoalLead) -> Vec<f64> {
+        let mut goal = desired.to_vec();
+        let to_go = desired[0] - achieved[0];
+        if to_go.abs() < lead.within {
+            goal[0] += lead.share * to_go;
+        }
+        goal
     }
 }
 

@@ -32,7 +32,7 @@ pub mod vec_env;
 use std::sync::Arc;
 
 pub use dexcube_sim::SimError;
-pub use goal::{Goal, LayerGoal, RotGoal, RotMode};
+pub use goal::{Goal, GoalLead, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{
     BASE_OBSERVATION, DROP_DEPTH, ObjectKind, SETTLE_STEPS, View, base_observation, is_dropped,
     is_square, resting_point, set_down,

@@ -3,7 +3,7 @@
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::rot::PAPER_TARGETS;
 use dexcube_env::{
-    ControlRate, CubeLayer, CubeRotEnv, Goal, GoalEnv, LayerGoal, LayerMove, LayerOpEnv,
+    ControlRate, CubeLayer, CubeRotEnv, Goal, GoalEnv, GoalLead, LayerGoal, LayerMove, LayerOpEnv,
     ObjectKind, RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, VecEnv, View,
     pose_goal,
 };
@@ -148,6 +148,79 @@ fn rot_success_is_detected_just_inside_and_not_just_outside_the_thresholds() {
         let sideways = rotation::mul(&about([1.0, 0.0, 0.0], 1.5), &target_q);
         assert!(!judge(rest, sideways, &mut env), "{mode:?}: on its side");
     }
+}
+
+/// A goal led on shows the error still to go, as the test reads it, `1 + share` times as
+/// large, on the far side of the goal, and leaves the goal as it is further off than `within`
+/// or where the test reads nothing more (the misalignment).
+#[test]
+fn a_goal_led_on_lies_further_on_by_its_share_of_the_error() {
+    let lead = GoalLead {
+        share: 0.5,
+        within: 0.5,
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(40);
+    let unit = |rng: &mut ChaCha8Rng| {
+        let v: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+        let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        v.map(|x| x / n)
+    };
+    for mode in [RotMode::Paper, RotMode::Axis, RotMode::Pair] {
+        let test = RotGoal::paper(mode).left_square();
+        for case in 0..50 {
+            let target = rotation::about(unit(&mut rng), rng.random_range(0.0..3.0));
+            // In pair mode, also a cube turned upside down from the target, then tilted.
+            let flip = if mode == RotMode::Pair && case % 2 == 1 {
+                about([1.0, 0.0, 0.0], std::f64::consts::PI)
+            } else {
+                rotation::IDENTITY
+            };
+            let off = about(unit(&mut rng), rng.random_range(0.02..0.45));
+            let now = rotation::mul(&off, &rotation::mul(&flip, &target));
+            let at =
+                |position: [f64; 3], q: rotation::Quat| test.achieved(&pose_goal(position, q), 0.3);
+            let achieved = at([0.01, -0.004, 0.003], now);
+            let desired = test.desired(&pose_goal([0.0; 3], target));
+            let (distance, angle) = test.errors(&achieved, &desired);
+            let led = test.led(&achieved, &desired, lead);
+            let (led_distance, led_angle) = test.errors(&achieved, &led);
+            assert!(
+                (led_angle - 1.5 * angle).abs() < 1e-9
+                    && (led_distance - 1.5 * distance).abs() < 1e-12,
+                "{mode:?}: {angle} and {distance} to go shown as {led_angle} and {led_distance}"
+            );
+            let (_, beyond) = test.errors(&desired, &led);
+            assert!(
+                (beyond - 0.5 * angle).abs() < 1e-9,
+                "{mode:?}: {beyond} past the goal"
+            );
+            assert_eq!(led[7], desired[7], "the desired misalignment stays");
+        }
+        let far = at_angle(&test, 0.6);
+        assert_eq!(
+            test.led(&far.0, &far.1, lead),
+            far.1,
+            "{mode:?}: 0.6 rad off"
+        );
+    }
+    let layer = LayerGoal::square();
+    let led = layer.led(&[1.3, 0.2], &[FRAC_PI_2, 0.0], lead);
+    assert!((led[0] - (FRAC_PI_2 + 0.5 * (FRAC_PI_2 - 1.3))).abs() < 1e-12);
+    assert_eq!(led[1], 0.0);
+    assert_eq!(
+        layer.led(&[0.9, 0.0], &[FRAC_PI_2, 0.0], lead),
+        [FRAC_PI_2, 0.0]
+    );
+}
+
+/// An achieved and a desired pose `angle` apart by a tilt about x, as `test` has them.
+fn at_angle(test: &RotGoal, angle: f64) -> (Vec<f64>, Vec<f64>) {
+    let target = about([0.0, 1.0, 0.0], FRAC_PI_2);
+    let now = rotation::mul(&about([1.0, 0.0, 0.0], angle), &target);
+    (
+        test.achieved(&pose_goal([0.0; 3], now), 0.0),
+        test.desired(&pose_goal([0.0; 3], target)),
+    )
 }
 
 #[test]

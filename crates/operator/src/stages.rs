@@ -10,7 +10,8 @@ use dexcube_cube::Face;
 use dexcube_env::random::uniform_rotation;
 use dexcube_env::{
     ControlRate, CubeLayer, CubeRotEnv, Goal, LayerGoal, RecordedStart, RotGoal, RotMode,
-    SETTLE_STEPS, View, achieved_goal, is_dropped, pose_goal, rot_observation, set_down,
+    SETTLE_STEPS, View, achieved_goal, cube_misalignment, is_dropped, pose_goal, rot_observation,
+    set_down,
 };
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
@@ -324,9 +325,14 @@ impl Stage1 for PolicyStage1 {
             .driving
             .stage1_steadying
             .map(|steadying| Steadier::new(steadying, position));
+        let test = self.goal;
         let act = |sim: &Sim| {
             steadied_action(steadier.as_mut(), sim, || {
-                policy.act(&rot_observation(sim, view, None), &goal)
+                let pose = sim.object_pose();
+                let achieved =
+                    achieved_goal(&test, sim, &pose_goal(pose.position, pose.orientation));
+                let observation = rot_observation(sim, view, None);
+                policy.act_toward(&observation, (&achieved, &goal), &test)
             })
         };
         drive(
@@ -454,11 +460,15 @@ impl Stage2 for PolicyStage2 {
             return StageRun::default();
         };
         let mut view = view.with_view(self.view);
-        let goal = self.goal.desired(FRAC_PI_2);
+        let (test, goal) = (self.goal, self.goal.desired(FRAC_PI_2));
         let policy = &self.policy;
         drive(
             sim,
-            |sim| policy.act(&view.observe(sim), &goal),
+            |sim| {
+                let observation = view.observe(sim);
+                let achieved = test.achieved(view.turned(), cube_misalignment(sim));
+                policy.act_toward(&observation, (&achieved, &goal), &test)
+            },
             self.resting_z,
             self.driving.gradual_opening,
             &mut |_| false,

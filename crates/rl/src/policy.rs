@@ -6,10 +6,14 @@
 //! with the other members' actors beside it in the same files (their tensors named
 //! `partner{i}.…`, their sizes and normalisers in the card's `partners`). It acts with the
 //! mean of its members' deterministic actions.
+//!
+//! A policy may be shown its goal led on ([`Policy::led`], [`GoalLead`]): its card says how,
+//! and whoever runs it acts through [`Policy::act_toward`], which applies it.
 
 use std::path::{Path, PathBuf};
 
 use burn::prelude::*;
+use dexcube_env::{Goal, GoalLead};
 use serde::{Deserialize, Serialize};
 
 use crate::agent::{Agent, Dims, network_inputs};
@@ -35,6 +39,10 @@ pub struct PolicyCard {
     /// A run's critics choosing among actions near the policy's own; none for the paper's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub guide: Option<GuideCard>,
+    /// The goal the policy is shown, led on past the one it is judged by; none for the
+    /// paper's, which is shown its goal as it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal_lead: Option<GoalLead>,
 }
 
 /// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
@@ -81,6 +89,16 @@ pub(crate) fn read_single(
     used: &str,
 ) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>), CheckpointError> {
     let (weights, card, tensors) = read_stored(prefix)?;
+    if let Some(lead) = &card.goal_lead {
+        return Err(mismatch(
+            &weights,
+            format!(
+                "it is shown its goal led on (by {} within {} rad) and cannot be {used}: use the \
+                 policy it was made from (its card's metadata.led names it)",
+                lead.share, lead.within
+            ),
+        ));
+    }
     if let Some(guide) = &card.guide {
         return Err(mismatch(
             &weights,
@@ -136,6 +154,7 @@ impl Policy {
             metadata,
             partners: Vec::new(),
             guide: None,
+            goal_lead: None,
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -321,6 +340,41 @@ impl Policy {
         checkpoint::save_json(&card_path, &card)
     }
 
+    /// Writes at `out` the policy at `policy` (a single one, an ensemble or a guided one)
+    /// shown its goal led on as `lead` says ([`GoalLead`]); its weights are unchanged. The card
+    /// records the policy and `command`, the command that led it.
+    pub fn led(
+        policy: &Path,
+        lead: GoalLead,
+        out: &Path,
+        command: &str,
+    ) -> Result<(), CheckpointError> {
+        let (weights, card, tensors) = read_stored(policy)?;
+        if card.goal_lead.is_some() {
+            return Err(mismatch(
+                &weights,
+                "its goal is led on already: lead the policy it was made from".to_string(),
+            ));
+        }
+        let label = card.metadata["label"].as_str().unwrap_or("a policy");
+        let card = PolicyCard {
+            metadata: serde_json::json!({
+                "label": format!(
+                    "{label}, its goal led on by {} within {} rad",
+                    lead.share, lead.within
+                ),
+                "environment": card.metadata["environment"],
+                "led": policy,
+                "command": command,
+            }),
+            goal_lead: Some(lead),
+            ..card
+        };
+        let (weights, card_path) = policy_paths(out);
+        checkpoint::save_tensors(&weights, &tensors)?;
+        checkpoint::save_json(&card_path, &card)
+    }
+
     /// Loads the policy at `prefix` onto `device`.
     pub fn load(prefix: &Path, device: &Device) -> Result<Policy, CheckpointError> {
         let (weights, card, tensors) = read_stored(prefix)?;
@@ -367,6 +421,7 @@ impl Policy {
             card: PolicyCard {
                 partners: Vec::new(),
                 guide: None,
+                goal_lead: None,
                 ..self.card.clone()
             },
             actor,
@@ -396,8 +451,23 @@ impl Policy {
         1 + self.partners.len()
     }
 
-    /// The deterministic action for one observation and goal: an ensemble's is the mean of its
-    /// members'.
+    /// The deterministic action toward `desired` for one observation, the object's goal now
+    /// being `achieved`, both as `test` reads them: shown the goal led on where the card says
+    /// so, else `desired` itself.
+    pub fn act_toward(
+        &self,
+        observation: &[f64],
+        (achieved, desired): (&[f64], &[f64]),
+        test: &dyn Goal,
+    ) -> Vec<f64> {
+        match self.card.goal_lead {
+            Some(lead) => self.act(observation, &test.led(achieved, desired, lead)),
+            None => self.act(observation, desired),
+        }
+    }
+
+    /// The deterministic action for one observation and the goal it is shown: an ensemble's is
+    /// the mean of its members'.
     pub fn act(&self, observation: &[f64], goal: &[f64]) -> Vec<f64> {
         let card = &self.card;
         let mut total = self.member_action(

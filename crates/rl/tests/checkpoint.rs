@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use dexcube_env::{Goal, GoalEnv, Info, Observation, Spaces, Transition};
+use dexcube_env::{Goal, GoalEnv, GoalLead, Info, Observation, Spaces, Transition};
 use dexcube_rl::params::NamedTensor;
 use dexcube_rl::point_mass::{PointGoal, PointMassEnv};
 use dexcube_rl::{Agent, DdpgHerConfig, Policy, TrainOptions, train};
@@ -891,4 +891,51 @@ fn a_policy_guided_by_its_run_s_critics_ships_them_and_bad_critics_are_clear_err
         message.contains("bad.safetensors") && message.contains("guide's critic 0"),
         "{message}"
     );
+}
+
+#[test]
+fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
+    let dir = fresh_dir("dexcube-rl-goal-lead");
+    train(PointMassEnv::default, config(), &options(&dir, 1, false)).unwrap();
+    let device = burn::prelude::Device::flex();
+    let policy = dir.join("policy");
+    let lead = GoalLead {
+        share: 0.5,
+        within: 0.5,
+    };
+    let out = dir.join("led");
+    Policy::led(&policy, lead, &out, "dexcube goal-lead ...").unwrap();
+    let (plain, led) = (
+        Policy::load(&policy, &device).unwrap(),
+        Policy::load(&out, &device).unwrap(),
+    );
+    assert_eq!(led.card.goal_lead, Some(lead));
+    assert_eq!(led.card.metadata["led"], policy.display().to_string());
+    // The point mass's goal read as a layer angle and a misalignment: only the first moves on.
+    let test = dexcube_env::LayerGoal::square();
+    let mut env = PointMassEnv::default();
+    let mut differs = false;
+    for seed in 0..5 {
+        let (obs, _) = env.reset(Some(seed));
+        let goals = (&obs.achieved_goal[..], &obs.desired_goal[..]);
+        let shown = test.led(goals.0, goals.1, lead);
+        assert_eq!(
+            led.act_toward(&obs.observation, goals, &test),
+            plain.act(&obs.observation, &shown)
+        );
+        assert_eq!(
+            plain.act_toward(&obs.observation, goals, &test),
+            plain.act(&obs.observation, &obs.desired_goal),
+            "a policy without a lead is shown its goal as it is"
+        );
+        differs |= shown != obs.desired_goal;
+    }
+    assert!(differs, "some goal lay within reach of the lead");
+    let err = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
+        result.err().unwrap().to_string()
+    };
+    let again = Policy::led(&out, lead, &dir.join("x"), "test");
+    assert!(err(again).contains("led on already"));
+    let joined = Policy::ensemble(&[out.clone(), policy.clone()], &dir.join("x"), "test");
+    assert!(err(joined).contains("shown its goal led on (by 0.5 within 0.5 rad)"));
 }
