@@ -1257,8 +1257,8 @@ fn eval_stage_writes_a_row_per_episode() {
 fn a_policy_led_on_runs_on_the_goal_led_on() {
     let dir = fresh_dir("dexcube-cli-goal-lead");
     std::fs::create_dir_all(&dir).unwrap();
-    let layer = models().join("layer");
-    let layer = layer.to_str().unwrap();
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let (rot, layer) = (rot.to_str().unwrap(), layer.to_str().unwrap());
     let led = dir.join("layer-led");
     let led = led.to_str().unwrap();
     let o = dexcube(&["goal-lead", layer, "--share", "0.5", "--out", led], "");
@@ -1271,8 +1271,9 @@ fn a_policy_led_on_runs_on_the_goal_led_on() {
         let csv = dir.join("episodes.csv");
         let args = [
             &["eval-stage", "layer", "--episodes", "1", "--threads", "1"][..],
-            &["--seed", "8000014", "--episodes-csv", csv.to_str().unwrap()],
-            &["--layer-policy", policy],
+            // An episode that turns the layer, so that it comes within the lead's reach.
+            &["--seed", "8000016", "--episodes-csv", csv.to_str().unwrap()],
+            &["--rot-policy", rot, "--layer-policy", policy],
         ]
         .concat();
         let o = dexcube(&args, "");
