@@ -845,8 +845,10 @@ fn episode(
     watch(env.sim_mut());
     let test = env.goal();
     loop {
-        let goals = (&obs.achieved_goal[..], &obs.desired_goal[..]);
-        let t = env.step(&policy.act_toward(&obs.observation, goals, test.as_ref()));
+        let achieved = || obs.achieved_goal.clone();
+        let action =
+            policy.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
+        let t = env.step(&action);
         watch(env.sim_mut());
         hold = if meets_paper_test(&t.info, thresholds) {
             hold + 1

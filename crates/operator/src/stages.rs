@@ -328,11 +328,12 @@ impl Stage1 for PolicyStage1 {
         let test = self.goal;
         let act = |sim: &Sim| {
             steadied_action(steadier.as_mut(), sim, || {
-                let pose = sim.object_pose();
-                let achieved =
-                    achieved_goal(&test, sim, &pose_goal(pose.position, pose.orientation));
+                let achieved = || {
+                    let pose = sim.object_pose();
+                    achieved_goal(&test, sim, &pose_goal(pose.position, pose.orientation))
+                };
                 let observation = rot_observation(sim, view, None);
-                policy.act_toward(&observation, (&achieved, &goal), &test)
+                policy.act_toward(&observation, &goal, achieved, &test)
             })
         };
         drive(
@@ -466,8 +467,8 @@ impl Stage2 for PolicyStage2 {
             sim,
             |sim| {
                 let observation = view.observe(sim);
-                let achieved = test.achieved(view.turned(), cube_misalignment(sim));
-                policy.act_toward(&observation, (&achieved, &goal), &test)
+                let achieved = || test.achieved(view.turned(), cube_misalignment(sim));
+                policy.act_toward(&observation, &goal, achieved, &test)
             },
             self.resting_z,
             self.driving.gradual_opening,

@@ -451,17 +451,18 @@ impl Policy {
         1 + self.partners.len()
     }
 
-    /// The deterministic action toward `desired` for one observation, the object's goal now
-    /// being `achieved`, both as `test` reads them: shown the goal led on where the card says
-    /// so, else `desired` itself.
+    /// The deterministic action toward `desired` for one observation, judged by `test`: shown
+    /// the goal led on where the card says so, from the object's goal now, which `achieved`
+    /// reads only then; else `desired` itself.
     pub fn act_toward(
         &self,
         observation: &[f64],
-        (achieved, desired): (&[f64], &[f64]),
+        desired: &[f64],
+        achieved: impl FnOnce() -> Vec<f64>,
         test: &dyn Goal,
     ) -> Vec<f64> {
         match self.card.goal_lead {
-            Some(lead) => self.act(observation, &test.led(achieved, desired, lead)),
+            Some(lead) => self.act(observation, &test.led(&achieved(), desired, lead)),
             None => self.act(observation, desired),
         }
     }

@@ -917,15 +917,16 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
     let mut differs = false;
     for seed in 0..5 {
         let (obs, _) = env.reset(Some(seed));
-        let goals = (&obs.achieved_goal[..], &obs.desired_goal[..]);
-        let shown = test.led(goals.0, goals.1, lead);
+        let (achieved, desired) = (&obs.achieved_goal, &obs.desired_goal);
+        let shown = test.led(achieved, desired, lead);
         assert_eq!(
-            led.act_toward(&obs.observation, goals, &test),
+            led.act_toward(&obs.observation, desired, || achieved.clone(), &test),
             plain.act(&obs.observation, &shown)
         );
+        let unread = || -> Vec<f64> { panic!("a policy without a lead reads no achieved goal") };
         assert_eq!(
-            plain.act_toward(&obs.observation, goals, &test),
-            plain.act(&obs.observation, &obs.desired_goal),
+            plain.act_toward(&obs.observation, desired, unread, &test),
+            plain.act(&obs.observation, desired),
             "a policy without a lead is shown its goal as it is"
         );
         differs |= shown != obs.desired_goal;
