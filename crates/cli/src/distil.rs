@@ -13,6 +13,7 @@ use dexcube_env::{SimulatedEnv, StartMix, StartPick};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
 use dexcube_rl::distil::{Demonstrations, DistilConfig, fit};
+use dexcube_rl::policy::policy_file;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::env::{EnvKind, starts_for};
@@ -94,7 +95,7 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
     let files = args.policies.files()?;
     let setup = StageSetup::new(args.stage, &files, None, None)?;
     let same_file = |a: &std::path::Path, b: &std::path::Path| {
-        let card = |p: &std::path::Path| p.with_extension("json").canonicalize().ok();
+        let card = |p: &std::path::Path| policy_file(p, "json").canonicalize().ok();
         a == b || card(a).is_some_and(|a| Some(a) == card(b))
     };
     if same_file(&args.out, &setup.prefix) {

@@ -21,6 +21,7 @@ use dexcube_operator::stages::{Driving, Steadying};
 use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
+use dexcube_rl::policy::policy_file;
 use dexcube_rl::start_file::{StartsOrigin, save_starts};
 use dexcube_sim::cube::{read_puzzle, turned_since};
 use dexcube_sim::{Scene, SceneKind, Sim};
@@ -306,7 +307,7 @@ impl PolicyArgs {
     /// The policy files, checked to exist, with Stage 1's mode read from its card.
     pub fn files(&self) -> anyhow::Result<PolicyFiles> {
         for prefix in [&self.rot_policy, &self.layer_policy] {
-            let card = prefix.with_extension("json");
+            let card = policy_file(prefix, "json");
             if !card.is_file() {
                 bail!(
                     "no policy at {}: the shipped ones are under models/ (git checkout models), or train one \
@@ -315,7 +316,7 @@ impl PolicyArgs {
                 );
             }
         }
-        let card_path = self.rot_policy.with_extension("json");
+        let card_path = policy_file(&self.rot_policy, "json");
         let card: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&card_path)?)
                 .with_context(|| format!("{} is not a policy card (JSON)", card_path.display()))?;
@@ -654,8 +655,8 @@ fn check_same_run(
     let identity = serde_json::json!({
         "seed": seed,
         "operator": operator.name(),
-        "rot_policy": fingerprint(&files.rot.with_extension("safetensors"))?,
-        "layer_policy": fingerprint(&files.layer.with_extension("safetensors"))?,
+        "rot_policy": fingerprint(&policy_file(&files.rot, "safetensors"))?,
+        "layer_policy": fingerprint(&policy_file(&files.layer, "safetensors"))?,
     });
     let (csv, sidecar) = (out.with_extension("csv"), out.with_extension("run.json"));
     if csv.exists() {
@@ -1126,7 +1127,7 @@ fn record(
     (successes, square_successes): (usize, usize),
     (lo, hi): (f64, f64),
 ) -> anyhow::Result<()> {
-    let path = prefix.with_extension("json");
+    let path = policy_file(prefix, "json");
     let mut card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)
         .with_context(|| format!("reading {}", path.display()))?;
     let key = if own {

@@ -14,6 +14,7 @@ use dexcube_env::{
 use dexcube_operator::eval::PolicyFiles;
 use dexcube_operator::stages::{PolicyStage1, PolicyStage2, trained_control_rate};
 use dexcube_rl::Policy;
+use dexcube_rl::policy::policy_file;
 use dexcube_sim::Scene;
 
 use crate::env::{EnvKind, original_object, suited};
@@ -139,7 +140,7 @@ pub fn meets_paper_test(info: &Info, (position, angle): (f64, f64)) -> bool {
 fn trained_on(policy: &Policy, prefix: &Path, env: EnvKind) -> anyhow::Result<ObjectKind> {
     let object = match policy.card.metadata["environment"]["object"].as_str() {
         Some(name) => name.parse().map_err(|e: String| {
-            anyhow::anyhow!("{}: {e}", prefix.with_extension("json").display())
+            anyhow::anyhow!("{}: {e}", policy_file(prefix, "json").display())
         })?,
         None => original_object(env),
     };

@@ -133,9 +133,24 @@ fn mismatch(path: &Path, message: String) -> CheckpointError {
 /// `prefix.safetensors` and `prefix.json`.
 pub fn policy_paths(prefix: &Path) -> (PathBuf, PathBuf) {
     (
-        prefix.with_extension("safetensors"),
-        prefix.with_extension("json"),
+        policy_file(prefix, "safetensors"),
+        policy_file(prefix, "json"),
     )
+}
+
+/// A policy's file with `extension` (`safetensors` or `json`) beside `prefix`: appended, so
+/// that a prefix with a dot in its name (`runs/rot-lead0.5`) keeps it; a prefix given with
+/// either file's extension (`models/rot.json`) names the same policy.
+pub fn policy_file(prefix: &Path, extension: &str) -> PathBuf {
+    match prefix.extension().and_then(|e| e.to_str()) {
+        Some("safetensors" | "json") => prefix.with_extension(extension),
+        _ => {
+            let mut name = prefix.as_os_str().to_owned();
+            name.push(".");
+            name.push(extension);
+            PathBuf::from(name)
+        }
+    }
 }
 
 impl Policy {

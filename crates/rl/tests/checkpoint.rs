@@ -903,8 +903,10 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
         share: 0.5,
         within: 0.5,
     };
-    let out = dir.join("led");
+    // A dot in the name is part of it, not an extension to replace.
+    let out = dir.join("led0.5");
     Policy::led(&policy, lead, &out, "dexcube goal-lead ...").unwrap();
+    assert!(dir.join("led0.5.safetensors").is_file() && dir.join("led0.5.json").is_file());
     let (plain, led) = (
         Policy::load(&policy, &device).unwrap(),
         Policy::load(&out, &device).unwrap(),
@@ -939,4 +941,9 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
     assert!(err(again).contains("led on already"));
     let joined = Policy::ensemble(&[out.clone(), policy.clone()], &dir.join("x"), "test");
     assert!(err(joined).contains("shown its goal led on (by 0.5 within 0.5 rad)"));
+    // Either file's name names the same policy.
+    for named in ["led0.5.json", "led0.5.safetensors"] {
+        let again = Policy::load(&dir.join(named), &device).unwrap();
+        assert_eq!(again.card.goal_lead, Some(lead), "{named}");
+    }
 }
