@@ -290,14 +290,18 @@ pub fn physics_spread(text: &str) -> Result<f64, String> {
     }
 }
 
-/// `--angle-threshold RAD` for `train`: a success test's angle threshold, above 0 and
-/// below π.
-pub fn angle_threshold(text: &str) -> Result<f64, String> {
+/// `--angle-threshold RAD` for `train`: a success test's angle threshold.
+fn angle_threshold(text: &str) -> Result<f64, String> {
+    angle_flag("--angle-threshold", " (the paper's is 0.1)", text)
+}
+
+/// An angle in radians given to `flag`, above 0 and below π; `hint` follows the range in the
+/// refusal.
+pub fn angle_flag(flag: &str, hint: &str, text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(angle) if angle > 0.0 && angle < std::f64::consts::PI => Ok(angle),
         _ => Err(format!(
-            "--angle-threshold must be an angle in radians above 0 and below π (the paper's is \
-             0.1), not '{text}'"
+            "{flag} must be an angle in radians above 0 and below π{hint}, not '{text}'"
         )),
     }
 }

@@ -12,7 +12,9 @@ use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
-use crate::env::{EnvChoice, EnvKind, PAPER_ANGLE_THRESHOLD, physics_spread, starts_for};
+use crate::env::{
+    EnvChoice, EnvKind, PAPER_ANGLE_THRESHOLD, angle_flag, physics_spread, starts_for,
+};
 
 /// How training collects experience, shared by `train` and `bench rl`. Eight environments
 /// on two threads balance physics against the 40 batches of a cycle on a 2-core machine.
@@ -284,12 +286,7 @@ fn lead_share(text: &str) -> Result<f64, String> {
 }
 
 fn lead_within(text: &str) -> Result<f64, String> {
-    match text.parse::<f64>() {
-        Ok(within) if within > 0.0 && within < std::f64::consts::PI => Ok(within),
-        _ => Err(format!(
-            "--within must be an angle in radians above 0 and below π, not '{text}'"
-        )),
-    }
+    angle_flag("--within", "", text)
 }
 
 pub fn goal_lead(args: GoalLeadArgs) -> anyhow::Result<ExitCode> {

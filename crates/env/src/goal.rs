@@ -30,8 +30,7 @@ pub trait Goal: Send + Sync {
 
     /// The goal `desired` led on past where it lies, as `lead` says, for an object whose goal
     /// is now `achieved`. A goal space with no way on shows `desired` as it is.
-    fn led(&self, achieved: &[f64], desired: &[f64], lead: GoalLead) -> Vec<f64> {
-        let _ = (achieved, lead);
+    fn led(&self, _achieved: &[f64], desired: &[f64], _lead: GoalLead) -> Vec<f64> {
         desired.to_vec()
     }
 }

@@ -81,6 +81,30 @@ fn read_stored(prefix: &Path) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>),
     Ok((weights, card, tensors))
 }
 
+/// Writes a policy's weights and card at `prefix` (`prefix.safetensors` and `prefix.json`).
+fn store(prefix: &Path, tensors: &[NamedTensor], card: &PolicyCard) -> Result<(), CheckpointError> {
+    let (weights, card_path) = policy_paths(prefix);
+    checkpoint::save_tensors(&weights, tensors)?;
+    checkpoint::save_json(&card_path, card)
+}
+
+/// The metadata of a policy made from the one at `source` (its card `card`) by `command`: its
+/// label with `how` after it, its environment, and the source under `key` ("guided", "led").
+fn derived_metadata(
+    card: &PolicyCard,
+    how: String,
+    (key, source): (&str, &Path),
+    command: &str,
+) -> serde_json::Value {
+    let label = card.metadata["label"].as_str().unwrap_or("a policy");
+    serde_json::json!({
+        "label": format!("{label}, {how}"),
+        "environment": card.metadata["environment"],
+        key: source,
+        "command": command,
+    })
+}
+
 /// The same for a single policy, refusing an ensemble with a message saying it cannot be
 /// `used` ("averaged", "joined", "trained from"): whatever combines or trains from policies
 /// takes each member's one actor.
@@ -173,9 +197,7 @@ impl Policy {
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
-            let (weights, card_path) = policy_paths(prefix);
-            checkpoint::save_tensors(&weights, &actor)?;
-            checkpoint::save_json(&card_path, &card)?;
+            store(prefix, &actor, &card)?;
         }
         Ok(())
     }
@@ -243,9 +265,7 @@ impl Policy {
             }),
             ..first_card.clone()
         };
-        let (weights, card_path) = policy_paths(out);
-        checkpoint::save_tensors(&weights, &mean)?;
-        checkpoint::save_json(&card_path, &card)
+        store(out, &mean, &card)
     }
 
     /// Writes at `out` an ensemble of the policies at `members`: one policy that acts with the
@@ -303,9 +323,7 @@ impl Policy {
             partners,
             ..head
         };
-        let (weights, card_path) = policy_paths(out);
-        checkpoint::save_tensors(&weights, &tensors)?;
-        checkpoint::save_json(&card_path, &card)
+        store(out, &tensors, &card)
     }
 
     /// Writes at `out` the policy at `policy` (a single one or an ensemble) guided by the
@@ -339,20 +357,13 @@ impl Policy {
             ));
         }
         tensors.extend(critics);
-        let label = card.metadata["label"].as_str().unwrap_or("a policy");
+        let how = format!("guided by the critics of {}", run.display());
         let card = PolicyCard {
-            metadata: serde_json::json!({
-                "label": format!("{label}, guided by the critics of {}", run.display()),
-                "environment": card.metadata["environment"],
-                "guided": policy,
-                "command": command,
-            }),
+            metadata: derived_metadata(&card, how, ("guided", policy), command),
             guide: Some(guide),
             ..card
         };
-        let (weights, card_path) = policy_paths(out);
-        checkpoint::save_tensors(&weights, &tensors)?;
-        checkpoint::save_json(&card_path, &card)
+        store(out, &tensors, &card)
     }
 
     /// Writes at `out` the policy at `policy` (a single one, an ensemble or a guided one)
@@ -371,23 +382,16 @@ impl Policy {
                 "its goal is led on already: lead the policy it was made from".to_string(),
             ));
         }
-        let label = card.metadata["label"].as_str().unwrap_or("a policy");
+        let how = format!(
+            "its goal led on by {} within {} rad",
+            lead.share, lead.within
+        );
         let card = PolicyCard {
-            metadata: serde_json::json!({
-                "label": format!(
-                    "{label}, its goal led on by {} within {} rad",
-                    lead.share, lead.within
-                ),
-                "environment": card.metadata["environment"],
-                "led": policy,
-                "command": command,
-            }),
+            metadata: derived_metadata(&card, how, ("led", policy), command),
             goal_lead: Some(lead),
             ..card
         };
-        let (weights, card_path) = policy_paths(out);
-        checkpoint::save_tensors(&weights, &tensors)?;
-        checkpoint::save_json(&card_path, &card)
+        store(out, &tensors, &card)
     }
 
     /// Loads the policy at `prefix` onto `device`.
@@ -456,9 +460,7 @@ impl Policy {
                     .to_string(),
             ));
         }
-        let (weights, card_path) = policy_paths(prefix);
-        checkpoint::save_tensors(&weights, &params::read(&self.actor))?;
-        checkpoint::save_json(&card_path, &self.card)
+        store(prefix, &params::read(&self.actor), &self.card)
     }
 
     /// How many actors act together: 1, or an ensemble's members.
