@@ -21,7 +21,7 @@ use dexcube_operator::stages::{Driving, Steadying};
 use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::write_atomically;
-use dexcube_rl::policy::policy_file;
+use dexcube_rl::policy::{PolicyCard, policy_file};
 use dexcube_rl::start_file::{StartsOrigin, save_starts};
 use dexcube_sim::cube::{read_puzzle, turned_since};
 use dexcube_sim::{Scene, SceneKind, Sim};
@@ -643,8 +643,9 @@ fn fingerprint(path: &Path) -> anyhow::Result<String> {
     Ok(format!("{hash:016x}"))
 }
 
-/// A rerun may only continue PREFIX.csv if it was made with the same policies (by content),
-/// seed and operator; PREFIX.run.json records them. More cubes per distance, or more
+/// A rerun may only continue PREFIX.csv if it was made with the same policies (by content:
+/// the weights, and a guide's or goal lead's settings from the card), seed and operator;
+/// PREFIX.run.json records them. More cubes per distance, or more
 /// distances, are fine: scrambles at a seed are prefix-stable.
 fn check_same_run(
     out: &Path,
@@ -652,12 +653,19 @@ fn check_same_run(
     seed: u64,
     operator: OperatorArgs,
 ) -> anyhow::Result<()> {
-    let identity = serde_json::json!({
+    let mut identity = serde_json::json!({
         "seed": seed,
         "operator": operator.name(),
         "rot_policy": fingerprint(&policy_file(&files.rot, "safetensors"))?,
         "layer_policy": fingerprint(&policy_file(&files.layer, "safetensors"))?,
     });
+    for (key, prefix) in [("rot_acting", &files.rot), ("layer_acting", &files.layer)] {
+        let card = PolicyCard::read(prefix)
+            .with_context(|| format!("reading the card of {}", prefix.display()))?;
+        if let Some(settings) = card.acting_settings() {
+            identity[key] = settings;
+        }
+    }
     let (csv, sidecar) = (out.with_extension("csv"), out.with_extension("run.json"));
     if csv.exists() {
         let before: Option<serde_json::Value> = std::fs::read_to_string(&sidecar)

@@ -250,6 +250,28 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
         let refused = dexcube(&[&args[..], other].concat(), "");
         assert_clean_failure(&refused, 2, "or another operator");
     }
+    // So would continuing it with the same weights acting otherwise: Stage 1 led on.
+    let led = out.with_file_name("rot-led");
+    let rot = models().join("rot");
+    let lead = [
+        &["goal-lead", rot.to_str().unwrap(), "--share", "0.5"][..],
+        &["--out", led.to_str().unwrap()],
+    ]
+    .concat();
+    assert!(dexcube(&lead, "").status.success());
+    let with_led: Vec<&str> = args
+        .iter()
+        .map(|&a| {
+            if a == rot.to_str().unwrap() {
+                led.to_str().unwrap()
+            } else {
+                a
+            }
+        })
+        .collect();
+    assert_ne!(with_led, args);
+    let refused = dexcube(&with_led, "");
+    assert_clean_failure(&refused, 2, "holds results of other policies");
     // Naming the defaults is the same operator.
     let defaults = [&args[..], &["--stage1-held", "5", "--opening", "gradual"]].concat();
     assert!(dexcube(&defaults, "").status.success());

@@ -146,6 +146,34 @@ pub(crate) fn read_single(
     ))
 }
 
+impl PolicyCard {
+    /// The card of the policy at `prefix`, without its weights.
+    pub fn read(prefix: &Path) -> Result<PolicyCard, CheckpointError> {
+        checkpoint::load_json(&policy_file(prefix, "json"))
+    }
+
+    /// What on the card, besides the weights, decides how the policy acts: its guide's
+    /// settings (how many candidates, how far, drawn from which seed) and its goal lead.
+    /// None for a policy that acts on its weights alone.
+    pub fn acting_settings(&self) -> Option<serde_json::Value> {
+        let mut settings = serde_json::Map::new();
+        if let Some(guide) = &self.guide {
+            settings.insert(
+                "guide".into(),
+                serde_json::json!({
+                    "candidates": guide.candidates,
+                    "spread": guide.spread,
+                    "seed": guide.seed,
+                }),
+            );
+        }
+        if let Some(lead) = &self.goal_lead {
+            settings.insert("goal_lead".into(), serde_json::json!(lead));
+        }
+        (!settings.is_empty()).then_some(serde_json::Value::Object(settings))
+    }
+}
+
 /// The error for stored weights or cards at `path` that do not fit what they are used for.
 fn mismatch(path: &Path, message: String) -> CheckpointError {
     CheckpointError::Mismatch {
