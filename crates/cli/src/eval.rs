@@ -20,7 +20,7 @@ use dexcube_operator::eval::{
 use dexcube_operator::stages::{Driving, Steadying};
 use dexcube_operator::{OperatorConfig, Planner, hand_price};
 use dexcube_rl::Policy;
-use dexcube_rl::checkpoint::write_atomically;
+use dexcube_rl::checkpoint::{file_beside, write_atomically};
 use dexcube_rl::policy::{PolicyCard, policy_file};
 use dexcube_rl::start_file::{StartsOrigin, save_starts};
 use dexcube_sim::cube::{read_puzzle, turned_since};
@@ -416,7 +416,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         optimal: &table_all,
         any_length: hand_plans.as_ref(),
     };
-    let csv = args.out.with_extension("csv");
+    let csv = table_file(&args.out, "csv");
     check_same_run(&args.out, &files, args.seed, args.operator)?;
     let mut results: Vec<CubeResult> = std::fs::read_to_string(&csv)
         .map(|text| {
@@ -501,7 +501,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         write_atomically(&csv, (text.join("\n") + "\n").as_bytes())?;
         let rows = table(&sorted, &distances);
         write_atomically(
-            &args.out.with_extension("md"),
+            &table_file(&args.out, "md"),
             markdown(&rows, &sorted, &command(&sorted)).as_bytes(),
         )?;
         Ok(())
@@ -587,7 +587,7 @@ pub fn eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let rows = table(&results, &distances);
-    if let Err(e) = plot(&rows, &args.out) {
+    if let Err(e) = plot(&rows, &table_file(&args.out, "md")) {
         eprintln!("warning: no plot: {e}");
     }
     print!("{}", markdown(&rows, &results, &command(&results)));
@@ -633,6 +633,13 @@ fn in_episode_order<T>(gathered: Mutex<Vec<(usize, T)>>) -> Vec<T> {
     gathered.into_iter().map(|(_, item)| item).collect()
 }
 
+/// The file with `extension` (csv, md, run.json) of the table at `out`: `--out
+/// results/lead0.5` writes `results/lead0.5.csv`, and `--out results/table.csv` names the same
+/// table as `--out results/table`.
+fn table_file(out: &Path, extension: &str) -> PathBuf {
+    file_beside(out, extension, &["csv", "md"])
+}
+
 /// A 64-bit FNV-1a fingerprint of a file's bytes.
 fn fingerprint(path: &Path) -> anyhow::Result<String> {
     let bytes = std::fs::read(path)
@@ -666,7 +673,7 @@ fn check_same_run(
             identity[key] = settings;
         }
     }
-    let (csv, sidecar) = (out.with_extension("csv"), out.with_extension("run.json"));
+    let (csv, sidecar) = (table_file(out, "csv"), table_file(out, "run.json"));
     if csv.exists() {
         let before: Option<serde_json::Value> = std::fs::read_to_string(&sidecar)
             .ok()
@@ -893,8 +900,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let (thresholds, control_rate) = (setup.thresholds, setup.control_rate);
     if args.record && args.physics_spread > 0.0 {
         bail!(
-            "--physics-spread must be 0 or more, and 0 with --record (a policy's evaluation is on \
-             the scene's own physics), not {}",
+            "--record writes the policy's evaluation on the scene's own physics, not under \
+             --physics-spread {}: drop one of the two",
             args.physics_spread
         );
     }

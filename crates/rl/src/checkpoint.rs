@@ -10,6 +10,22 @@ use safetensors::tensor::{Dtype, TensorView};
 
 use crate::params::NamedTensor;
 
+/// The file with `extension` of the files sharing `prefix`: appended, so that a prefix with a
+/// dot in its name (`runs/rot-lead0.5`) keeps it, where `Path::with_extension` would replace
+/// the text after the dot; a prefix given with one of its files' extensions (`own`) names the
+/// same files.
+pub fn file_beside(prefix: &Path, extension: &str, own: &[&str]) -> PathBuf {
+    match prefix.extension().and_then(|e| e.to_str()) {
+        Some(given) if own.contains(&given) => prefix.with_extension(extension),
+        _ => {
+            let mut name = prefix.as_os_str().to_owned();
+            name.push(".");
+            name.push(extension);
+            PathBuf::from(name)
+        }
+    }
+}
+
 #[derive(Debug)]
 pub enum CheckpointError {
     Io { path: PathBuf, message: String },

@@ -190,19 +190,10 @@ pub fn policy_paths(prefix: &Path) -> (PathBuf, PathBuf) {
     )
 }
 
-/// A policy's file with `extension` (`safetensors` or `json`) beside `prefix`: appended, so
-/// that a prefix with a dot in its name (`runs/rot-lead0.5`) keeps it; a prefix given with
-/// either file's extension (`models/rot.json`) names the same policy.
+/// A policy's file with `extension` (`safetensors` or `json`) beside `prefix` (see
+/// [`checkpoint::file_beside`]): `models/rot.json` names the same policy as `models/rot`.
 pub fn policy_file(prefix: &Path, extension: &str) -> PathBuf {
-    match prefix.extension().and_then(|e| e.to_str()) {
-        Some("safetensors" | "json") => prefix.with_extension(extension),
-        _ => {
-            let mut name = prefix.as_os_str().to_owned();
-            name.push(".");
-            name.push(extension);
-            PathBuf::from(name)
-        }
-    }
+    checkpoint::file_beside(prefix, extension, &["safetensors", "json"])
 }
 
 impl Policy {
