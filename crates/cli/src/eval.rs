@@ -652,8 +652,8 @@ fn fingerprint(path: &Path) -> anyhow::Result<String> {
 
 /// A rerun may only continue PREFIX.csv if it was made with the same policies (by content:
 /// the weights, and a guide's or goal lead's settings from the card), seed and operator;
-/// PREFIX.run.json records them. More cubes per distance, or more
-/// distances, are fine: scrambles at a seed are prefix-stable.
+/// PREFIX.run.json records them. More cubes per distance, or more distances, are fine:
+/// scrambles at a seed are prefix-stable.
 fn check_same_run(
     out: &Path,
     files: &PolicyFiles,
