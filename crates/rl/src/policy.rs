@@ -75,17 +75,16 @@ fn partner_prefix(i: usize) -> String {
 
 /// A policy's card and weights as stored, read for combining with others.
 fn read_stored(prefix: &Path) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>), CheckpointError> {
-    let (weights, card_path) = policy_paths(prefix);
-    let card: PolicyCard = checkpoint::load_json(&card_path)?;
+    let weights = policy_file(prefix, "safetensors");
+    let card = PolicyCard::read(prefix)?;
     let tensors = checkpoint::load_tensors(&weights)?;
     Ok((weights, card, tensors))
 }
 
 /// Writes a policy's weights and card at `prefix` (`prefix.safetensors` and `prefix.json`).
 fn store(prefix: &Path, tensors: &[NamedTensor], card: &PolicyCard) -> Result<(), CheckpointError> {
-    let (weights, card_path) = policy_paths(prefix);
-    checkpoint::save_tensors(&weights, tensors)?;
-    checkpoint::save_json(&card_path, card)
+    checkpoint::save_tensors(&policy_file(prefix, "safetensors"), tensors)?;
+    checkpoint::save_json(&policy_file(prefix, "json"), card)
 }
 
 /// The metadata of a policy made from the one at `source` (its card `card`) by `command`: its
@@ -180,14 +179,6 @@ fn mismatch(path: &Path, message: String) -> CheckpointError {
         path: path.to_path_buf(),
         message,
     }
-}
-
-/// `prefix.safetensors` and `prefix.json`.
-pub fn policy_paths(prefix: &Path) -> (PathBuf, PathBuf) {
-    (
-        policy_file(prefix, "safetensors"),
-        policy_file(prefix, "json"),
-    )
 }
 
 /// A policy's file with `extension` (`safetensors` or `json`) beside `prefix` (see
