@@ -69,6 +69,11 @@ pub struct TrainArgs {
     /// Keep the policy of every this many epochs under DIR/snapshots (0: none).
     #[arg(long, default_value_t = 5)]
     snapshot_every: usize,
+    /// Units in each of the networks' three hidden layers (the paper's 256). A warm start
+    /// (--init, --init-actor) from narrower networks embeds them, so the wider networks begin
+    /// acting as they did. A resume must say it again.
+    #[arg(long, default_value_t = 256, value_name = "UNITS", value_parser = clap::value_parser!(u16).range(1..))]
+    width: u16,
     /// Optimisation batches per cycle (HER baselines: 40).
     #[arg(long, default_value_t = 40)]
     batches: usize,
@@ -328,6 +333,7 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
         _ => "no --starts".to_string(),
     };
     let environment = &begun.environment;
+    let begun_hidden = begun.config.hidden.clone();
     let begun = flags(
         environment["starts"].as_str().map(str::to_string),
         environment["start_share"].as_f64(),
@@ -359,6 +365,14 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
              {begun_rate}, not {}",
             run.display(),
             args.choice.control_rate
+        );
+    }
+    if begun_hidden.iter().any(|&units| units != usize::from(args.width)) {
+        bail!(
+            "{} began with hidden layers of {begun_hidden:?} units; resume it with the same \
+             --width, not {}",
+            run.display(),
+            args.width
         );
     }
     // Runs from before physics could be varied ran on the scene's own, and runs from before
@@ -470,6 +484,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         actor_lr: args.actor_lr.unwrap_or(published.actor_lr),
         anchor: args.anchor,
         drop_cost: args.drop_cost,
+        hidden: vec![usize::from(args.width); published.hidden.len()],
         ..published
     };
     if args.td3 {

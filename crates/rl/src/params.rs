@@ -122,6 +122,61 @@ pub fn insert_zero_inputs(
     true
 }
 
+/// Sets the parameters `saved` from a network into `fresh`, the freshly made parameters of the
+/// same network with wider hidden layers, so that the wider network computes what the saved
+/// one did. Each saved tensor fills the first rows and columns of its fresh one (a weight is
+/// `[inputs, outputs]`); the weights from a new unit to an old one are zero; the new units
+/// keep their fresh weights and biases. A new unit so starts with random inputs and no say in
+/// the output, and gradients reach it at once through its zero outgoing weights. (Net2Net's
+/// aim, Chen, Goodfellow and Shlens 2016, without its copied units, which would learn alike.)
+/// Tensors of the same shape are taken as saved. Fails, saying why, if a tensor is missing or
+/// a saved one is larger than its fresh one in any dimension, as of a deeper, narrower or
+/// other network.
+pub fn embed_in_wider(
+    saved: &[NamedTensor],
+    fresh: Vec<NamedTensor>,
+) -> Result<Vec<NamedTensor>, String> {
+    if saved.len() != fresh.len() {
+        return Err(format!(
+            "{} saved tensors, {} in this network: only the hidden layers' width can grow",
+            saved.len(),
+            fresh.len()
+        ));
+    }
+    fresh
+        .into_iter()
+        .map(|mut wide| {
+            let narrow = saved
+                .iter()
+                .find(|t| t.name == wide.name)
+                .ok_or_else(|| format!("no saved tensor named '{}'", wide.name))?;
+            match (&narrow.shape[..], &wide.shape[..]) {
+                (a, b) if a == b => return Ok(narrow.clone()),
+                (&[rows], &[wide_rows]) if rows <= wide_rows => {
+                    wide.values[..rows].copy_from_slice(&narrow.values);
+                }
+                (&[rows, cols], &[wide_rows, wide_cols]) if rows <= wide_rows && cols <= wide_cols => {
+                    for r in 0..wide_rows {
+                        let row = &mut wide.values[r * wide_cols..r * wide_cols + cols];
+                        if r < rows {
+                            row.copy_from_slice(&narrow.values[r * cols..(r + 1) * cols]);
+                        } else {
+                            row.fill(0.0);
+                        }
+                    }
+                }
+                (a, b) => {
+                    return Err(format!(
+                        "'{}' is saved as {a:?} and cannot grow into {b:?}",
+                        wide.name
+                    ));
+                }
+            }
+            Ok(wide)
+        })
+        .collect()
+}
+
 /// A parameter that did not fit.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ParamMismatch {

@@ -642,7 +642,8 @@ fn resume(
 /// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had
 /// a shorter goal, as when a success test gains a part (LayerOpEnv's good state), or a shorter
 /// observation, as when the policy is shown more (LayerOpEnv's view of the misalignment): the
-/// new inputs then start with zero weights, see [`widen_inputs`].
+/// new inputs then start with zero weights, see [`widen_inputs`]. The new run's hidden layers
+/// may be wider than the saved ones, see [`embed_in_wider`].
 fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Result<(), TrainError> {
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
@@ -666,8 +667,8 @@ fn warm_start(agent: &mut Agent, dir: &Path, actor_from: Option<&Path>) -> Resul
 }
 
 /// Takes the actor (and its target) and the normalisers of the policy at `prefix` for a new
-/// run whose critic starts afresh. The policy may have had a shorter goal or observation, as
-/// for [`warm_start`].
+/// run whose critic starts afresh. The policy may have had a shorter goal or observation, or
+/// narrower hidden layers, as for [`warm_start`].
 fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> {
     let (mut actor, card) = read_policy(prefix)?;
     let (saved, needed) = (card.dims, agent.dims);
@@ -686,12 +687,29 @@ fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> 
     )
     .map_err(|message| mismatch(prefix, message))?;
     let mut networks = agent.networks();
+    let actor = crate::params::embed_in_wider(&actor, networks[0].clone())
+        .map_err(|message| mismatch(prefix, message))?;
     (networks[0], networks[2]) = (actor.clone(), actor);
     agent
         .load_networks(&networks)
         .map_err(|e| mismatch(prefix, e.to_string()))?;
     agent.observation_norm = observation_norm;
     agent.goal_norm = goal_norm;
+    Ok(())
+}
+
+/// Fits saved networks to this run's hidden layers where the run's are wider, each into the
+/// fresh network of the run in the same place (see [`crate::params::embed_in_wider`]): a
+/// warm start onto a wider network computes what the saved one did, and learns with the room
+/// the new units give. Networks of the run's own widths are taken as saved.
+fn embed_in_wider(
+    saved: &mut [Vec<crate::params::NamedTensor>],
+    fresh: impl IntoIterator<Item = Vec<crate::params::NamedTensor>>,
+    from: &Path,
+) -> Result<(), TrainError> {
+    for (network, fresh) in saved.iter_mut().zip(fresh) {
+        *network = crate::params::embed_in_wider(network, fresh).map_err(|m| mismatch(from, m))?;
+    }
     Ok(())
 }
 
@@ -807,6 +825,10 @@ fn load_checkpoint(
             agent.dims,
         )
         .map_err(|message| mismatch(checkpoint_dir, message))?;
+    }
+    embed_in_wider(&mut networks, agent.networks(), checkpoint_dir)?;
+    if let (Some(twin), Some(fresh)) = (twin.as_mut(), agent.twin_networks()) {
+        embed_in_wider(twin, fresh, checkpoint_dir)?;
     }
     agent
         .load_networks(&networks)

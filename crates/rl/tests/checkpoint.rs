@@ -947,3 +947,108 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
         assert_eq!(again.card.goal_lead, Some(lead), "{named}");
     }
 }
+
+/// The outputs of `net` on a fixed batch of `inputs`-long rows.
+fn outputs_on_a_batch(net: &dexcube_rl::networks::Mlp, inputs: usize) -> Vec<f32> {
+    use burn::prelude::*;
+    let rows = 16;
+    let values: Vec<f32> = (0..rows * inputs)
+        .map(|k| ((k * 37 % 23) as f32 - 11.0) / 5.0)
+        .collect();
+    let batch: Tensor<2> = Tensor::from_data(
+        burn::tensor::TensorData::new(values, [rows, inputs]),
+        &burn::prelude::Device::flex(),
+    );
+    net.forward(batch)
+        .into_data()
+        .convert::<f32>()
+        .try_to_vec::<f32>()
+        .unwrap()
+}
+
+/// A network embedded in a wider one computes what it did, while its new units hold fresh
+/// random inputs (so they can learn apart) and zero outgoing weights; networks that cannot
+/// grow into the new one are refused, saying why.
+#[test]
+fn a_network_embedded_in_wider_layers_computes_what_it_did() {
+    use dexcube_rl::networks::Mlp;
+    use dexcube_rl::params::{embed_in_wider, read, write};
+    let device = burn::prelude::Device::flex();
+    device.seed(3);
+    let narrow = Mlp::new(6, &[5, 5], 3, &device);
+    let wide = Mlp::new(6, &[9, 9], 3, &device);
+    let embedded = embed_in_wider(&read(&narrow), read(&wide)).unwrap();
+    let wide = write(wide, &embedded, |_, given| given.to_vec()).unwrap();
+    let (before, after) = (outputs_on_a_batch(&narrow, 6), outputs_on_a_batch(&wide, 6));
+    assert!(before.iter().any(|&y| y.abs() > 1e-3), "a batch that tells");
+    for (b, a) in before.iter().zip(&after) {
+        assert!((b - a).abs() < 1e-5, "{b} became {a}");
+    }
+    let tensor = |name: &str| embedded.iter().find(|t| t.name == name).unwrap();
+    let hidden = tensor("layers.1.weight");
+    assert_eq!(hidden.shape, [9, 9]);
+    let new_units_in = |r: usize| &hidden.values[r * 9 + 5..(r + 1) * 9];
+    assert!(
+        (0..9).all(|r| new_units_in(r).iter().any(|&w| w != 0.0)),
+        "a new unit takes fresh inputs from every unit before it"
+    );
+    let out = tensor("layers.2.weight");
+    assert!(
+        out.values[5 * 3..].iter().all(|&w| w == 0.0),
+        "the new units have no say in the output yet"
+    );
+    let same = embed_in_wider(&read(&narrow), read(&narrow)).unwrap();
+    assert_eq!(same, read(&narrow), "a network of the same widths is taken as saved");
+    let err = embed_in_wider(&read(&wide), read(&narrow)).unwrap_err();
+    assert!(err.contains("cannot grow"), "{err}");
+    let deeper = Mlp::new(6, &[5, 5, 5], 3, &device);
+    let err = embed_in_wider(&read(&narrow), read(&deeper)).unwrap_err();
+    assert!(err.contains("only the hidden layers' width can grow"), "{err}");
+}
+
+/// A run of wider hidden layers warm-starts from a narrower run: the actor and both critics
+/// carry the saved weights in their first units, the card says the run's widths, and a
+/// narrower run is refused.
+#[test]
+fn a_warm_start_onto_wider_hidden_layers_embeds_the_saved_networks() {
+    let (source, dir, warm, frozen) = warm_start_from_a_new_run("dexcube-rl-wider");
+    let wider = DdpgHerConfig {
+        hidden: vec![48, 48],
+        ..frozen
+    };
+    let run = train(PointMassEnv::default, wider, &warm).unwrap();
+    for (k, name) in ["actor", "critic"].into_iter().enumerate() {
+        let saved = dexcube_rl::checkpoint::load_tensors(
+            &source.join(format!("checkpoint/{name}.safetensors")),
+        )
+        .unwrap();
+        let now = &run.agent.networks()[k];
+        let middle = |set: &[NamedTensor]| {
+            set.iter()
+                .find(|t| t.name == "layers.1.weight")
+                .unwrap()
+                .clone()
+        };
+        let (saved, now) = (middle(&saved), middle(now));
+        assert_eq!(now.shape, [48, 48], "{name}");
+        for r in 0..48 {
+            let kept = &now.values[r * 48..r * 48 + 32];
+            if r < 32 {
+                assert_eq!(kept, &saved.values[r * 32..(r + 1) * 32], "{name} row {r}");
+            } else {
+                assert!(kept.iter().all(|&w| w == 0.0), "{name} row {r}");
+            }
+        }
+    }
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap()).unwrap();
+    assert_eq!(card["config"]["hidden"], serde_json::json!([48, 48]));
+    let narrower = DdpgHerConfig {
+        hidden: vec![16, 16],
+        ..config()
+    };
+    let err = train(PointMassEnv::default, narrower, &warm)
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("cannot grow"), "{err}");
+}
