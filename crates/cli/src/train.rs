@@ -367,7 +367,10 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
             args.choice.control_rate
         );
     }
-    if begun_hidden.iter().any(|&units| units != usize::from(args.width)) {
+    if begun_hidden
+        .iter()
+        .any(|&units| units != usize::from(args.width))
+    {
         bail!(
             "{} began with hidden layers of {begun_hidden:?} units; resume it with the same \
              --width, not {}",

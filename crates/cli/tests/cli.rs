@@ -716,9 +716,10 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
 /// 17's with failed starts drawn 20 times as often (a card that names the weight by Stage 1's
 /// failures, `dropped_weight`); only at the control rate it began with (session 12's, from
 /// before the rate could be chosen, the paper's); and only on the physics it began with
-/// (before physics could be varied, the scene's own).
+/// (before physics could be varied, the scene's own); and only with networks of the width it
+/// began with.
 #[test]
-fn train_resumes_only_with_the_starts_the_rate_and_the_physics_it_began_with() {
+fn train_resumes_only_with_the_starts_rate_physics_and_width_it_began_with() {
     let resume = |committed_run: &str, starts: &[&str]| {
         let run = std::env::temp_dir().join(format!("dexcube-cli-resume-{committed_run}"));
         let _ = std::fs::remove_dir_all(&run);
@@ -784,6 +785,12 @@ fn train_resumes_only_with_the_starts_the_rate_and_the_physics_it_began_with() {
         ),
         2,
         "began with --angle-threshold 0.1; resume it with the same, not 0.05",
+    );
+    assert_clean_failure(
+        &resume("rot-pair-cube-square-anchor5-seed0", &["--width", "512"]),
+        2,
+        "began with hidden layers of [256, 256, 256] units; resume it with the same --width, \
+         not 512",
     );
 }
 

@@ -155,7 +155,9 @@ pub fn embed_in_wider(
                 (&[rows], &[wide_rows]) if rows <= wide_rows => {
                     wide.values[..rows].copy_from_slice(&narrow.values);
                 }
-                (&[rows, cols], &[wide_rows, wide_cols]) if rows <= wide_rows && cols <= wide_cols => {
+                (&[rows, cols], &[wide_rows, wide_cols])
+                    if rows <= wide_rows && cols <= wide_cols =>
+                {
                     for r in 0..wide_rows {
                         let row = &mut wide.values[r * wide_cols..r * wide_cols + cols];
                         if r < rows {

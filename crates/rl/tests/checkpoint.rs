@@ -998,12 +998,19 @@ fn a_network_embedded_in_wider_layers_computes_what_it_did() {
         "the new units have no say in the output yet"
     );
     let same = embed_in_wider(&read(&narrow), read(&narrow)).unwrap();
-    assert_eq!(same, read(&narrow), "a network of the same widths is taken as saved");
+    assert_eq!(
+        same,
+        read(&narrow),
+        "a network of the same widths is taken as saved"
+    );
     let err = embed_in_wider(&read(&wide), read(&narrow)).unwrap_err();
     assert!(err.contains("cannot grow"), "{err}");
     let deeper = Mlp::new(6, &[5, 5, 5], 3, &device);
     let err = embed_in_wider(&read(&narrow), read(&deeper)).unwrap_err();
-    assert!(err.contains("only the hidden layers' width can grow"), "{err}");
+    assert!(
+        err.contains("only the hidden layers' width can grow"),
+        "{err}"
+    );
 }
 
 /// A run of wider hidden layers warm-starts from a narrower run: the actor and both critics
@@ -1047,8 +1054,6 @@ fn a_warm_start_onto_wider_hidden_layers_embeds_the_saved_networks() {
         hidden: vec![16, 16],
         ..config()
     };
-    let err = train(PointMassEnv::default, narrower, &warm)
-        .err()
-        .unwrap();
+    let err = train(PointMassEnv::default, narrower, &warm).err().unwrap();
     assert!(err.to_string().contains("cannot grow"), "{err}");
 }
