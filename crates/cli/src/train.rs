@@ -332,8 +332,16 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
         }
         _ => "no --starts".to_string(),
     };
+    let hidden = &begun.config.hidden;
+    if hidden.iter().any(|&units| units != usize::from(args.width)) {
+        bail!(
+            "{} began with hidden layers of {hidden:?} units; resume it with the same --width, \
+             not {}",
+            run.display(),
+            args.width
+        );
+    }
     let environment = &begun.environment;
-    let begun_hidden = begun.config.hidden.clone();
     let begun = flags(
         environment["starts"].as_str().map(str::to_string),
         environment["start_share"].as_f64(),
@@ -365,17 +373,6 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
              {begun_rate}, not {}",
             run.display(),
             args.choice.control_rate
-        );
-    }
-    if begun_hidden
-        .iter()
-        .any(|&units| units != usize::from(args.width))
-    {
-        bail!(
-            "{} began with hidden layers of {begun_hidden:?} units; resume it with the same \
-             --width, not {}",
-            run.display(),
-            args.width
         );
     }
     // Runs from before physics could be varied ran on the scene's own, and runs from before

@@ -687,8 +687,11 @@ fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> 
     )
     .map_err(|message| mismatch(prefix, message))?;
     let mut networks = agent.networks();
-    let actor = crate::params::embed_in_wider(&actor, networks[0].clone())
-        .map_err(|message| mismatch(prefix, message))?;
+    embed_in_wider(
+        std::slice::from_mut(&mut actor),
+        [networks[0].clone()],
+        prefix,
+    )?;
     (networks[0], networks[2]) = (actor.clone(), actor);
     agent
         .load_networks(&networks)
