@@ -687,11 +687,10 @@ fn warm_start_actor(agent: &mut Agent, prefix: &Path) -> Result<(), TrainError> 
     )
     .map_err(|message| mismatch(prefix, message))?;
     let mut networks = agent.networks();
-    embed_in_wider(
-        std::slice::from_mut(&mut actor),
-        [networks[0].clone()],
-        prefix,
-    )?;
+    // The run's fresh actor lends its new units to the wider layers, then the saved one
+    // embedded in it takes its place.
+    let fresh_actor = std::mem::take(&mut networks[0]);
+    embed_in_wider(std::slice::from_mut(&mut actor), [fresh_actor], prefix)?;
     (networks[0], networks[2]) = (actor.clone(), actor);
     agent
         .load_networks(&networks)
