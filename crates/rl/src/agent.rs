@@ -29,7 +29,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::config::DdpgHerConfig;
-use crate::networks::Mlp;
+use crate::networks::{Mlp, drawn_from_seed};
 use crate::normalizer::Normalizer;
 use crate::params;
 use dexcube_env::random::standard_normal;
@@ -124,23 +124,25 @@ pub struct Agent {
 }
 
 impl Agent {
-    /// A fresh agent on `device` (a plain backend device, e.g. `Device::flex()`); burn's
-    /// global seed is set from `seed` so the initial weights are reproducible.
+    /// A fresh agent on `device` (a plain backend device, e.g. `Device::flex()`); its initial
+    /// weights are drawn from `seed` alone ([`drawn_from_seed`]), so they are reproducible.
     pub fn new(dims: Dims, config: DdpgHerConfig, device: &Device, seed: u64) -> Agent {
-        device.seed(seed);
         let plain = device.clone();
         let autodiff = device.clone().autodiff();
         let input = dims.observation + dims.goal;
-        let actor = Mlp::new(input, &config.hidden, dims.action, &autodiff);
-        let critic = Mlp::new(input + dims.action, &config.hidden, 1, &autodiff);
-        // Made after the others, so that DDPG's initial weights do not depend on TD3's option.
-        let twin = config.twin_critics.then(|| {
+        let (actor, critic, twin_critic) = drawn_from_seed(device, seed, || {
+            let actor = Mlp::new(input, &config.hidden, dims.action, &autodiff);
             let critic = Mlp::new(input + dims.action, &config.hidden, 1, &autodiff);
-            TwinCritic {
-                target: critic.valid(),
-                critic,
-                optimizer: AdamConfig::new().init(),
-            }
+            // Made after the others, so that DDPG's initial weights do not depend on TD3's option.
+            let twin_critic = config
+                .twin_critics
+                .then(|| Mlp::new(input + dims.action, &config.hidden, 1, &autodiff));
+            (actor, critic, twin_critic)
+        });
+        let twin = twin_critic.map(|critic| TwinCritic {
+            target: critic.valid(),
+            critic,
+            optimizer: AdamConfig::new().init(),
         });
         let normalizer =
             |size| Normalizer::new(size, config.norm_eps, config.norm_clip, config.clip_obs);

@@ -5,6 +5,20 @@
 
 use burn::nn::{Linear, LinearConfig, Relu};
 use burn::prelude::*;
+use std::sync::{Mutex, PoisonError};
+
+/// burn's device draws every initial weight from one generator per process, so a seed and the
+/// draws it is meant for must not be split by another thread's seeding.
+static SEEDED_DRAWS: Mutex<()> = Mutex::new(());
+
+/// Seeds `device`'s generator with `seed` and runs `draw` (which makes networks on it) before
+/// any other seeded draw in the process, so the networks depend on `seed` alone, whichever
+/// other agents or tests are being made at the same time.
+pub fn drawn_from_seed<T>(device: &Device, seed: u64, draw: impl FnOnce() -> T) -> T {
+    let _only_draw = SEEDED_DRAWS.lock().unwrap_or_else(PoisonError::into_inner);
+    device.seed(seed);
+    draw()
+}
 
 #[derive(Module, Debug)]
 pub struct Mlp {

@@ -971,12 +971,15 @@ fn outputs_on_a_batch(net: &dexcube_rl::networks::Mlp, inputs: usize) -> Vec<f32
 /// grow into the new one are refused, saying why.
 #[test]
 fn a_network_embedded_in_wider_layers_computes_what_it_did() {
-    use dexcube_rl::networks::Mlp;
+    use dexcube_rl::networks::{Mlp, drawn_from_seed};
     use dexcube_rl::params::{embed_in_wider, read, write};
     let device = burn::prelude::Device::flex();
-    device.seed(3);
-    let narrow = Mlp::new(6, &[5, 5], 3, &device);
-    let wide = Mlp::new(6, &[9, 9], 3, &device);
+    let (narrow, wide) = drawn_from_seed(&device, 3, || {
+        (
+            Mlp::new(6, &[5, 5], 3, &device),
+            Mlp::new(6, &[9, 9], 3, &device),
+        )
+    });
     let embedded = embed_in_wider(&read(&narrow), read(&wide)).unwrap();
     let wide = write(wide, &embedded, |_, given| given.to_vec()).unwrap();
     let (before, after) = (outputs_on_a_batch(&narrow, 6), outputs_on_a_batch(&wide, 6));

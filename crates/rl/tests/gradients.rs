@@ -5,25 +5,16 @@
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use dexcube_rl::agent::Batch;
-use dexcube_rl::networks::Mlp;
+use dexcube_rl::networks::{Mlp, drawn_from_seed};
 use dexcube_rl::params;
 use dexcube_rl::{Agent, DdpgHerConfig, Dims, Learners};
-use std::sync::Mutex;
-
-/// The flex device's random generator is one for the process, and the tests run in parallel:
-/// each seeds it and draws its networks while holding this, so its draw is its seed's alone.
-static SEEDED_DRAW: Mutex<()> = Mutex::new(());
 
 #[test]
 fn autodiff_matches_finite_differences() {
     let device = Device::flex();
-    let net = {
-        let _draw = SEEDED_DRAW
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner());
-        device.seed(7);
+    let net = drawn_from_seed(&device, 7, || {
         Mlp::new(3, &[8, 8], 2, &device.clone().autodiff())
-    };
+    });
     let loss_at = |x: &[f32]| -> (f64, Vec<f64>) {
         let input: Tensor<2> = Tensor::from_data(
             TensorData::new(x.to_vec(), [1, 3]),
@@ -71,9 +62,6 @@ fn small_agent(seed: u64) -> (Agent, DdpgHerConfig) {
         batch_size: 8,
         ..DdpgHerConfig::default()
     };
-    let _draw = SEEDED_DRAW
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner());
     (
         Agent::new(dims, config.clone(), &Device::flex(), seed),
         config,
