@@ -12,9 +12,11 @@
 //! the recorded policy failed from, so that `dexcube train --starts OUT --failed-weight W`
 //! draws that side W times as often. With `--only-side SIDE OUT` it writes only the starts on
 //! that side, their marks as recorded: a run that trains there alone (`--start-share 1`), or
-//! an evaluation of that side alone (`dexcube eval-stage layer --starts OUT`).
+//! an evaluation of that side alone (`dexcube eval-stage layer --starts OUT`). With
+//! `--max-yaw DEG` first, the side takes in only its starts whose yaw from square is at most
+//! DEG degrees: the near-square placements on one side.
 //!
-//! `cargo run --release -p dexcube-operator --example stage2_start_geometry -- [--mark-side|--only-side SIDE OUT] STARTS...`
+//! `cargo run --release -p dexcube-operator --example stage2_start_geometry -- [--max-yaw DEG] [--mark-side|--only-side SIDE OUT] STARTS...`
 
 use std::path::Path;
 
@@ -57,8 +59,19 @@ fn on_side(offset: [f64; 2], side: [f64; 2]) -> bool {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let usage = "usage: stage2_start_geometry [--mark-side|--only-side x-|x+|y-|y+ OUT] STARTS...";
+    let usage = "usage: stage2_start_geometry [--max-yaw DEG] [--mark-side|--only-side x-|x+|y-|y+ OUT] STARTS...";
     let mut paths: Vec<String> = std::env::args().skip(1).collect();
+    let max_yaw = if paths.first().map(String::as_str) == Some("--max-yaw") && paths.len() > 1 {
+        let degrees = paths.remove(1);
+        paths.remove(0);
+        Some(
+            degrees
+                .parse::<f64>()
+                .map_err(|_| format!("--max-yaw takes degrees, not '{degrees}'"))?,
+        )
+    } else {
+        None
+    };
     let flag = paths.first().cloned().unwrap_or_default();
     let mark = match flag.as_str() {
         "--mark-side" | "--only-side" if paths.len() > 3 => {
@@ -97,9 +110,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .min_by(|a, b| a[2].abs().total_cmp(&b[2].abs()))
                 .expect("three faces");
             let yaw = side[1].atan2(side[0]).to_degrees().rem_euclid(90.0);
+            let yaw = yaw.min(90.0 - yaw);
             let offset = [0, 1].map(|k| 1000.0 * (pose.position[k] - resting[k]));
             if let Some(((_, _, side), only, _)) = &mark {
-                let there = on_side(offset, *side);
+                let there = on_side(offset, *side) && max_yaw.is_none_or(|most| yaw <= most);
                 let mut start = start.clone();
                 if !only {
                     start.failed |= there;
@@ -109,7 +123,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             starts.push(Start {
-                yaw: yaw.min(90.0 - yaw),
+                yaw,
                 offset,
                 failed: start.failed,
             });
@@ -140,7 +154,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let (Some(((tag, _, _), _, out)), Some(mut origin)) = (mark, first_origin) {
         origin.command = format!(
             "cargo run --release -p dexcube-operator --example stage2_start_geometry -- \
-             {flag} {tag} {out} {} (the first's command: {})",
+             {}{flag} {tag} {out} {} (the first's command: {})",
+            max_yaw.map_or(String::new(), |most| format!("--max-yaw {most} ")),
             paths.join(" "),
             origin.command
         );
