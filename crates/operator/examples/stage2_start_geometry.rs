@@ -61,16 +61,14 @@ fn on_side(offset: [f64; 2], side: [f64; 2]) -> bool {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let usage = "usage: stage2_start_geometry [--max-yaw DEG] [--mark-side|--only-side x-|x+|y-|y+ OUT] STARTS...";
     let mut paths: Vec<String> = std::env::args().skip(1).collect();
-    let max_yaw = if paths.first().map(String::as_str) == Some("--max-yaw") && paths.len() > 1 {
-        let degrees = paths.remove(1);
-        paths.remove(0);
-        Some(
-            degrees
-                .parse::<f64>()
-                .map_err(|_| format!("--max-yaw takes degrees, not '{degrees}'"))?,
-        )
-    } else {
-        None
+    let max_yaw = match paths.first().map(String::as_str) {
+        Some("--max-yaw") => {
+            let degrees = paths.get(1).ok_or(usage)?.clone();
+            paths.drain(..2);
+            let parsed = degrees.parse::<f64>();
+            Some(parsed.map_err(|_| format!("--max-yaw takes degrees, not '{degrees}'"))?)
+        }
+        _ => None,
     };
     let flag = paths.first().cloned().unwrap_or_default();
     let mark = match flag.as_str() {
