@@ -97,6 +97,11 @@ pub struct OperatorArgs {
     /// divides 20. Off by default.
     #[arg(long = "stage1-control-substeps", value_name = "N")]
     pub stage1_control_rate: Option<ControlRate>,
+    /// Run Stage 1 for up to this many control steps rather than its policy's episode (the
+    /// paper's 100 at its rate), still ending once held: time for poses the policy reaches
+    /// late. Off by default.
+    #[arg(long, value_name = "STEPS", value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub stage1_steps: Option<u64>,
 }
 
 /// A distance in metres, above 0 and at most 0.2 (beyond that the cube is off the palm).
@@ -157,6 +162,7 @@ impl OperatorArgs {
             steps: self.steady_steps as usize,
         });
         driving.stage1_control_rate = self.stage1_control_rate;
+        driving.stage1_steps = self.stage1_steps.map(|steps| steps as usize);
         OperatorConfig {
             rollback,
             plan_for_hand: !self.paper_operator,
@@ -224,8 +230,11 @@ impl OperatorArgs {
         let rate = driving.stage1_control_rate.map_or(String::new(), |n| {
             format!(", Stage 1 acting every {n} substeps")
         });
+        let budget = driving.stage1_steps.map_or(String::new(), |steps| {
+            format!(", Stage 1 up to {steps} steps")
+        });
         format!(
-            "{planner}{any_length}, opening the hand {opening}, {stage1}{rate}{steadying}{skip}{square}{puzzle_check}{first_move}"
+            "{planner}{any_length}, opening the hand {opening}, {stage1}{rate}{budget}{steadying}{skip}{square}{puzzle_check}{first_move}"
         )
     }
 
@@ -281,8 +290,11 @@ impl OperatorArgs {
         let rate = self
             .stage1_control_rate
             .map_or(String::new(), |n| format!(" --stage1-control-substeps {n}"));
+        let budget = self
+            .stage1_steps
+            .map_or(String::new(), |steps| format!(" --stage1-steps {steps}"));
         format!(
-            "{paper}{held}{opening}{already_up}{square}{puzzle_check}{first_move}{price}{steady}{rate}"
+            "{paper}{held}{opening}{already_up}{square}{puzzle_check}{first_move}{price}{steady}{rate}{budget}"
         )
     }
 }
@@ -740,6 +752,12 @@ pub struct EvalStageArgs {
     /// judged on. 0, the default, is the scene's own physics, the only one --record writes.
     #[arg(long, default_value_t = 0.0, value_name = "S", value_parser = physics_spread)]
     physics_spread: f64,
+    /// Run each episode for N control steps and judge it at the last, rather than for the
+    /// paper's 4 simulated seconds (100 steps at its rate): whether a policy's misses are
+    /// slow turns or poses, or ones more time does not mend. Only the paper's length can be
+    /// --record'ed.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    episode_steps: Option<u64>,
     /// Also write a video of the first episode (.gif, or .mp4 with ffmpeg installed): it is
     /// run once more on its own, as it ran among the others, to watch what the hand did.
     #[arg(long, value_name = "FILE")]
@@ -906,6 +924,13 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     setup.physics_spread = args.physics_spread;
+    if args.record && args.episode_steps.is_some() {
+        bail!(
+            "--record writes the policy's evaluation over the paper's episode, not over \
+             --episode-steps: drop one of the two"
+        );
+    }
+    setup.episode_steps = args.episode_steps.map(|steps| steps as usize);
     if args.record && control_rate != setup.trained_rate {
         bail!(
             "--record writes the policy's evaluation at the rate it was trained at ({} \
@@ -1062,6 +1087,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     }
     if args.physics_spread > 0.0 {
         from += &format!(", physics varied by spread {}", args.physics_spread);
+    }
+    if let Some(steps) = args.episode_steps {
+        from += &format!(", {steps} steps an episode");
     }
     println!(
         "{what}: {wins}/{episodes} = {rate:.3} (95% CI {lo:.3} to {hi:.3}), {from}, policy {}",
@@ -1282,5 +1310,16 @@ mod tests {
             ControlRate::every(10).ok()
         );
         assert!(parse(&["--stage1-control-substeps", "3"]).is_err());
+    }
+
+    /// A longer Stage 1 is part of the operator's name and flags.
+    #[test]
+    fn a_longer_stage_1_is_named_and_flagged() {
+        let args = parse_operator(&["--stage1-steps", "200"]).unwrap();
+        assert_eq!(args.config(false).driving.stage1_steps, Some(200));
+        assert!(args.name().contains(", Stage 1 up to 200 steps"));
+        let again = parse_operator(&args.flags().split_whitespace().collect::<Vec<_>>()).unwrap();
+        assert_eq!(again.config(false).driving.stage1_steps, Some(200));
+        assert!(parse_operator(&["--stage1-steps", "0"]).is_err());
     }
 }

@@ -37,6 +37,9 @@ pub struct StageSetup {
     /// How far each episode's physics is varied (`train --physics-spread`); 0, the scene's
     /// own, unless a caller sets it.
     pub physics_spread: f64,
+    /// Control steps to an episode where set (`eval-stage --episode-steps`); `None`, the
+    /// rate's 4 simulated seconds, unless a caller sets it.
+    pub episode_steps: Option<usize>,
 }
 
 impl StageSetup {
@@ -74,6 +77,7 @@ impl StageSetup {
             trained_rate,
             thresholds,
             physics_spread: 0.0,
+            episode_steps: None,
             prefix,
         })
     }
@@ -105,7 +109,8 @@ impl StageSetup {
                 let env = CubeRotEnv::with_scene(self.scene.clone(), goal)
                     .with_view(view)
                     .with_control_rate(self.control_rate)
-                    .with_physics_spread(self.physics_spread);
+                    .with_physics_spread(self.physics_spread)
+                    .with_episode_steps(self.episode_steps);
                 Box::new(env.with_starts(starts))
             }
             EnvKind::Layer => {
@@ -117,7 +122,8 @@ impl StageSetup {
                 .with_goal(PolicyStage2::trained_goal(policy, prefix)?)
                 .with_view(view)
                 .with_control_rate(self.control_rate)
-                .with_physics_spread(self.physics_spread);
+                .with_physics_spread(self.physics_spread)
+                .with_episode_steps(self.episode_steps);
                 Box::new(env.with_starts(starts))
             }
         })

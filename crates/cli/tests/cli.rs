@@ -1036,11 +1036,12 @@ fn average_and_ensemble_write_a_policy_eval_stage_runs_and_refuse_members_that_d
     }
 }
 
-/// `eval-stage --control-substeps` runs a policy at another control rate, and
-/// `--physics-spread` on varied physics, and each says so; the policy's card is written only
-/// at the rate it was trained at, on the scene's own physics.
+/// `eval-stage --control-substeps` runs a policy at another control rate,
+/// `--physics-spread` on varied physics and `--episode-steps` over another length, and each
+/// says so; the policy's card is written only at the rate it was trained at, on the scene's
+/// own physics, over the paper's episode.
 #[test]
-fn eval_stage_runs_a_policy_at_another_rate_or_physics_and_records_only_its_own() {
+fn eval_stage_runs_a_policy_at_another_rate_physics_or_length_and_records_only_its_own() {
     let dir = std::env::temp_dir().join("dexcube-cli-eval-stage-rate");
     let (rot, layer) = (copy_policy("rot", &dir, "rot"), models().join("layer"));
     let eval = ["eval-stage", "rot", "--episodes", "1", "--threads", "1"];
@@ -1052,34 +1053,35 @@ fn eval_stage_runs_a_policy_at_another_rate_or_physics_and_records_only_its_own(
         "--control-substeps",
         "10",
     ];
-    let o = dexcube(&[&eval[..], &rate].concat(), "");
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stdout(&o).contains("acting every 10 substeps (200 steps an episode)"),
-        "{}",
-        stdout(&o)
-    );
     let card_before = std::fs::read_to_string(dir.join("rot.json")).unwrap();
-    let o = dexcube(&[&eval[..], &rate, &["--record"]].concat(), "");
-    assert_clean_failure(
-        &o,
-        2,
-        "at the rate it was trained at (20 substeps), not at 10",
-    );
-    let varied = [&eval[..], &rate[..4], &["--physics-spread", "0.3"]].concat();
-    let o = dexcube(&varied, "");
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stdout(&o).contains("seed 1000000, physics varied by spread 0.3, policy"),
-        "{}",
-        stdout(&o)
-    );
-    let o = dexcube(&[&varied[..], &["--record"]].concat(), "");
-    assert_clean_failure(
-        &o,
-        2,
-        "on the scene's own physics, not under --physics-spread 0.3",
-    );
+    // Each way of running it: its flags, what the run says, and why --record refuses it.
+    let ways: [(&[&str], &str, &str); 3] = [
+        (
+            &rate[4..],
+            "acting every 10 substeps (200 steps an episode)",
+            "at the rate it was trained at (20 substeps), not at 10",
+        ),
+        (
+            &["--physics-spread", "0.3"],
+            "seed 1000000, physics varied by spread 0.3, policy",
+            "on the scene's own physics, not under --physics-spread 0.3",
+        ),
+        (
+            &["--episode-steps", "150"],
+            "seed 1000000, 150 steps an episode, policy",
+            "over the paper's episode, not over --episode-steps",
+        ),
+    ];
+    for (flags, says, refused) in ways {
+        let run = [&eval[..], &rate[..4], flags].concat();
+        let o = dexcube(&run, "");
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(stdout(&o).contains(says), "{}", stdout(&o));
+        let o = dexcube(&[&run[..], &["--record"]].concat(), "");
+        assert_clean_failure(&o, 2, refused);
+    }
+    let o = dexcube(&[&eval[..], &["--episode-steps", "0"]].concat(), "");
+    assert_clean_failure(&o, 2, "--episode-steps <N>");
     assert_eq!(
         std::fs::read_to_string(dir.join("rot.json")).unwrap(),
         card_before

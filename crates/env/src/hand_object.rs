@@ -168,6 +168,9 @@ pub struct HandObject {
     /// How far each episode's physics is varied ([`HandObject::begin_episode`]); 0, the
     /// paper's, keeps the scene's own.
     pub physics_spread: f64,
+    /// Control steps in an episode where set; `None` (the paper's) is the rate's 4 simulated
+    /// seconds ([`ControlRate::episode_steps`]).
+    pub episode_steps: Option<usize>,
 }
 
 impl HandObject {
@@ -190,6 +193,7 @@ impl HandObject {
             rate: ControlRate::PAPER,
             action_slew: None,
             physics_spread: 0.0,
+            episode_steps: None,
         }
     }
 
@@ -286,7 +290,7 @@ impl HandObject {
         let reward = goal.compute_reward(&observation.achieved_goal, &observation.desired_goal);
         Transition {
             terminated: info.dropped || info.physics_error.is_some(),
-            truncated: self.steps >= self.rate.episode_steps(),
+            truncated: self.steps >= self.episode_steps.unwrap_or(self.rate.episode_steps()),
             observation,
             reward,
             info,

@@ -393,6 +393,13 @@ impl LayerOpEnv {
         self
     }
 
+    /// The same environment with `steps` control steps to an episode where given, rather
+    /// than the rate's 4 simulated seconds ([`HandObject::episode_steps`]).
+    pub fn with_episode_steps(mut self, steps: Option<usize>) -> LayerOpEnv {
+        self.hand.episode_steps = steps;
+        self
+    }
+
     /// The same environment with each actuator's target moving at most `slew` action units
     /// per control step ([`HandObject::action_slew`]).
     pub fn with_action_slew(mut self, slew: Option<f64>) -> LayerOpEnv {

@@ -158,6 +158,13 @@ impl CubeRotEnv {
         self
     }
 
+    /// The same environment with `steps` control steps to an episode where given, rather
+    /// than the rate's 4 simulated seconds ([`HandObject::episode_steps`]).
+    pub fn with_episode_steps(mut self, steps: Option<usize>) -> CubeRotEnv {
+        self.hand.episode_steps = steps;
+        self
+    }
+
     /// How many numbers Stage 1 observes without a view beyond the paper's; a trained
     /// policy's view is told from how many more it takes ([`View::after`]: 62 with the
     /// misalignment, 67 with the grip, 68 with both).

@@ -838,6 +838,35 @@ fn a_faster_control_rate_keeps_the_episode_four_seconds_long() {
     }
 }
 
+/// An episode set to a length other than the paper's is truncated at that step, and only
+/// there, from the same placement.
+#[test]
+fn an_episode_set_longer_or_shorter_truncates_at_its_own_length() {
+    let scene = Scene::load(dexcube_sim::SceneKind::Rot).unwrap();
+    let run = |steps: Option<usize>| {
+        let mut env = CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper))
+            .with_episode_steps(steps);
+        let (first, _) = env.reset(Some(3));
+        (1..)
+            .find_map(|step| {
+                let t = env.step(&[0.0; 20]);
+                (t.terminated || t.truncated).then(|| {
+                    assert!(t.truncated, "a still hand keeps the cube");
+                    step
+                })
+            })
+            .map(|step| (first.observation, step))
+            .unwrap()
+    };
+    let (paper_start, paper_steps) = run(None);
+    for steps in [37, 150] {
+        let (start, truncated_at) = run(Some(steps));
+        assert_eq!(start, paper_start, "the same placement at any length");
+        assert_eq!(truncated_at, steps);
+    }
+    assert_eq!(paper_steps, dexcube_env::EPISODE_STEPS);
+}
+
 /// A slew limit moves each actuator's target at most that far per control step, towards the
 /// action asked for, and reaches it in as many steps as the distance needs; without one the
 /// target jumps at once.

@@ -10,9 +10,12 @@
 //! OUT` writes, for every jammed episode, the physics state at steps 10, 30 and 60 as Stage 2
 //! starts (the quarter turn asked for, counted from the angle the layer had turned, marked
 //! failed), so that a run can train from inside a jam (`dexcube train layer --starts OUT`).
+//! `--steps N` runs each episode for N control steps instead of the paper's 100, sorts it by
+//! how it stands at step N, and counts the episodes that step 100 judged otherwise: whether
+//! more time would turn the layers Stage 2 leaves unturned.
 //!
 //! `cargo run --release -p dexcube-operator --example stage2_jams -- POLICY
-//! (--fresh SEED EPISODES | --failed-starts FILE) [--slew S] [--keep-jams OUT]`
+//! (--fresh SEED EPISODES | --failed-starts FILE) [--slew S] [--keep-jams OUT] [--steps N]`
 
 use std::f64::consts::FRAC_PI_2;
 use std::path::{Path, PathBuf};
@@ -66,14 +69,16 @@ struct Args {
     starts: Starts,
     slew: Option<f64>,
     keep_jams: Option<PathBuf>,
+    steps: usize,
 }
 
 fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
     let usage = "usage: stage2_jams POLICY (--fresh SEED EPISODES | --failed-starts FILE) \
-                 [--slew S] [--keep-jams OUT]";
+                 [--slew S] [--keep-jams OUT] [--steps N]";
     let args: Vec<String> = std::env::args().skip(1).collect();
     let policy = PathBuf::from(args.first().ok_or(usage)?);
     let (mut starts, mut slew, mut keep_jams) = (None, None, None);
+    let mut steps = dexcube_env::EPISODE_STEPS;
     let mut rest = args[1..].iter();
     while let Some(flag) = rest.next() {
         let mut value = || rest.next().ok_or(usage);
@@ -90,6 +95,17 @@ fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
             }
             "--slew" => slew = Some(value()?.parse()?),
             "--keep-jams" => keep_jams = Some(PathBuf::from(value()?)),
+            "--steps" => {
+                steps = value()?.parse()?;
+                if steps < dexcube_env::EPISODE_STEPS {
+                    return Err(format!(
+                        "--steps {steps}: give at least the paper's {} steps, which it \
+                         compares with",
+                        dexcube_env::EPISODE_STEPS
+                    )
+                    .into());
+                }
+            }
             _ => return Err(usage.into()),
         }
     }
@@ -98,6 +114,7 @@ fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
         starts: starts.ok_or(usage)?,
         slew,
         keep_jams,
+        steps,
     })
 }
 
@@ -118,6 +135,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let [mut succeeded, mut jammed, mut other]: [Tally; 3] = Default::default();
     let mut jam_states = Vec::new();
+    // Episodes that step 100 judged a success and step N did not, and the other way round.
+    let (mut lost_later, mut won_later) = (0, 0);
     for episode in 0..episodes {
         let (mut observation, _) = match &args.starts {
             Starts::Fresh { seed, .. } => env.reset(Some(seed + episode as u64)),
@@ -126,6 +145,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (mut changes, mut kept) = (Vec::new(), Vec::new());
         let mut previous: Option<Vec<f64>> = None;
         let mut step = 0;
+        let mut success_at_paper_end = false;
         let info = loop {
             if KEPT_STEPS.contains(&step) {
                 kept.push(RecordedStart {
@@ -143,10 +163,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             step += 1;
             previous = Some(action);
             observation = transition.observation;
-            if transition.terminated || transition.truncated {
+            if step == dexcube_env::EPISODE_STEPS {
+                success_at_paper_end = transition.info.is_success;
+            }
+            if transition.terminated || step >= args.steps {
                 break transition.info;
             }
         };
+        match (success_at_paper_end, info.is_success) {
+            (true, false) => lost_later += 1,
+            (false, true) => won_later += 1,
+            _ => {}
+        }
         let tally = if info.is_success {
             &mut succeeded
         } else if !is_square(env.sim()) && !info.dropped && info.angle_error > NEVER_TURNED {
@@ -162,13 +190,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         tally.late_change += mean(&changes[early..]);
     }
     println!(
-        "policy {}, slew limit {:?}",
+        "policy {}, slew limit {:?}, {} steps an episode",
         args.policy.display(),
-        args.slew
+        args.slew,
+        args.steps
     );
     println!("{}", succeeded.line("succeeded"));
     println!("{}", jammed.line("jammed (never turned, left skewed)"));
     println!("{}", other.line("missed otherwise"));
+    if args.steps != dexcube_env::EPISODE_STEPS {
+        println!(
+            "against step {}: {won_later} failed there and succeeded at step {}, {lost_later} \
+             the other way round",
+            dexcube_env::EPISODE_STEPS,
+            args.steps
+        );
+    }
     if let Some(out) = &args.keep_jams {
         let origin = StartsOrigin {
             stage: "layer".into(),

@@ -514,7 +514,7 @@ fn randomising_the_pose_seats_the_cube_on_the_palm_and_keeps_the_layers() {
 
 /// A policy's Stage 1 told to end once the pose is held stops as soon as its test has passed
 /// for that many steps running: here the cube starts at rest with U up, the target.
-/// Without it the stage runs the policy's whole episode.
+/// Without it the stage runs the policy's whole episode, or the steps it was given.
 #[test]
 fn a_held_pose_ends_policy_stage_1_early() {
     let (mut stages, resting) = shipped_stages();
@@ -522,11 +522,12 @@ fn a_held_pose_ends_policy_stage_1_early() {
     let accepts = pose_reached(RotGoal::paper(RotMode::Pair));
     let settle = OPENING_STEPS;
     let mut steps = Vec::new();
-    for held in [None, Some(3)] {
+    for (held, budget) in [(None, None), (Some(3), None), (None, Some(150))] {
         let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
         set_up_scramble(&mut sim, &[], resting);
         stages.stage1.driving = Driving {
             stage1_held_steps: held,
+            stage1_steps: budget,
             ..Driving::default()
         };
         let run = stages.stage1.run(&mut sim, resting, target, &mut |_| {});
@@ -541,6 +542,7 @@ fn a_held_pose_ends_policy_stage_1_early() {
         (settle + 3..steps[0]).contains(&steps[1]),
         "held 3 steps, then ended: {steps:?}"
     );
+    assert_eq!(steps[2], settle + 150, "the steps it was given");
 }
 
 /// Opening gradually moves the hand's targets from where the last stage left them to the flat
