@@ -77,8 +77,9 @@ pub struct Driving {
     pub stage1_control_rate: Option<ControlRate>,
     /// Run Stage 1 for up to this many control steps rather than its policy's episode (4
     /// simulated seconds), still ending once held: a third of the shipped Stage 1's misses
-    /// from fresh placements reach the pose between steps 100 and 200
-    /// (`results/TRAINING.md`, session 47).
+    /// from fresh placements reach the pose between steps 100 and 200. Planning for the hand
+    /// it is 200 (Table I, session 47 in `results/TRAINING.md`: as many cubes with rollback,
+    /// fewer actions, more open loop).
     pub stage1_steps: Option<usize>,
 }
 
@@ -88,7 +89,7 @@ impl Driving {
         stage1_held_steps: Some(5),
         stage1_steadying: None,
         stage1_control_rate: None,
-        stage1_steps: None,
+        stage1_steps: Some(200),
     };
 }
 
