@@ -43,8 +43,8 @@ pub struct OperatorArgs {
     #[arg(long)]
     pub paper_operator: bool,
     /// End Stage 1 once the pose has been held for this many control steps (its success test
-    /// passing at each); 0 runs the policy's whole 100-step episode. Default: 5 planning for
-    /// the hand, 0 with --paper-operator.
+    /// passing at each); 0 runs Stage 1 for all its steps (--stage1-steps). Default: 5
+    /// planning for the hand, 0 with --paper-operator.
     #[arg(long, value_name = "STEPS", value_parser = clap::value_parser!(u64).range(0..=100))]
     pub stage1_held: Option<u64>,
     /// How the hand opens before each stage, from where the last one left it. Default:
