@@ -100,7 +100,7 @@ pub struct OperatorArgs {
     pub stage1_control_rate: Option<ControlRate>,
     /// Run Stage 1 for up to this many control steps rather than its policy's episode (the
     /// paper's 100 at its rate), still ending once held: time for poses the policy reaches
-    /// late. Default: 200 planning for the hand (since session 47; 100 reproduces the
+    /// late. Counted at the paper's rate, as --stage1-held is. Default: 200 planning for the hand (since session 47; 100 reproduces the
     /// figures made before), the policy's episode with --paper-operator.
     #[arg(long, value_name = "STEPS", value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub stage1_steps: Option<u64>,

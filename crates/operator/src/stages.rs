@@ -76,7 +76,9 @@ pub struct Driving {
     /// Run Stage 1's policy at this control rate rather than at the one it was trained at.
     pub stage1_control_rate: Option<ControlRate>,
     /// Run Stage 1 for up to this many control steps rather than its policy's episode (4
-    /// simulated seconds), still ending once held: a third of the shipped Stage 1's misses
+    /// simulated seconds), still ending once held; counted at the paper's rate, as
+    /// `stage1_held_steps` is, so that a faster rate gets as long. A third of the shipped
+    /// Stage 1's misses
     /// from fresh placements reach the pose between steps 100 and 200. Planning for the hand
     /// it is 200 (Table I, session 47 in `results/TRAINING.md`: as many cubes with rollback,
     /// fewer actions, more open loop).
@@ -180,9 +182,8 @@ pub const OPENING_STEPS: usize = 2 * SETTLE_STEPS;
 /// now and then, which `gradual_opening` avoids. These steps count as control steps, not as
 /// an action.
 ///
-/// The policy acts at `rate` (the one it was trained at, unless the operator asks for
-/// another) for `steps` control steps where given, else its episode's 4 simulated seconds;
-/// the hand opens at the paper's rate.
+/// The policy then acts for `episode`'s control steps at its rate (the one it was trained at,
+/// unless the operator asks for another); the hand opens at the paper's rate.
 fn drive(
     sim: &mut Sim,
     act: impl FnMut(&Sim) -> Vec<f64>,
@@ -190,7 +191,7 @@ fn drive(
     gradual_opening: bool,
     stop: &mut dyn FnMut(&Sim) -> bool,
     watch: Watch,
-    (steps, rate): (Option<usize>, ControlRate),
+    episode: (usize, ControlRate),
 ) -> StageRun {
     let mut run = StageRun::default();
     let open = sim.scene().open_hand_action();
@@ -212,7 +213,6 @@ fn drive(
     if !advance(sim, settling, opening, resting_z, watch, never, &mut run) {
         return run;
     }
-    let episode = (steps.unwrap_or(rate.episode_steps()), rate);
     advance(sim, act, episode, resting_z, watch, stop, &mut run);
     run
 }
@@ -313,11 +313,13 @@ impl Stage1 for PolicyStage1 {
             .driving
             .stage1_control_rate
             .unwrap_or(self.control_rate);
-        // Held for as long as at the paper's rate, however often the policy acts.
-        let held_steps = self
+        // Held, and run, for as long as at the paper's rate, however often the policy acts.
+        let at_rate = |paper_steps: usize| paper_steps * SUBSTEPS / rate.substeps();
+        let held_steps = self.driving.stage1_held_steps.map(at_rate);
+        let steps = self
             .driving
-            .stage1_held_steps
-            .map(|steps| steps * SUBSTEPS / rate.substeps());
+            .stage1_steps
+            .map_or(rate.episode_steps(), at_rate);
         let mut running = 0;
         let mut held = |sim: &Sim| {
             held_steps.is_some_and(|steps| {
@@ -351,7 +353,7 @@ impl Stage1 for PolicyStage1 {
             self.driving.gradual_opening,
             &mut held,
             watch,
-            (self.driving.stage1_steps, rate),
+            (steps, rate),
         )
     }
 }
@@ -482,7 +484,7 @@ impl Stage2 for PolicyStage2 {
             self.driving.gradual_opening,
             &mut |_| false,
             watch,
-            (None, self.control_rate),
+            (self.control_rate.episode_steps(), self.control_rate),
         )
     }
 }

@@ -868,8 +868,9 @@ fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
 
 /// A Stage 1 policy runs at the control rate it was trained at, or at the one the operator
 /// asks for: after the hand opens at the paper's rate, as many more, shorter steps as make
-/// the episode's 4 simulated seconds. A card that does not name a rate was trained at the
-/// paper's; one that names a rate no environment runs at is refused.
+/// the episode's 4 simulated seconds, and a step budget is counted at the paper's rate too. A
+/// card that does not name a rate was trained at the paper's; one that names a rate no
+/// environment runs at is refused.
 #[test]
 fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     let (mut stages, resting) = shipped_stages();
@@ -902,6 +903,19 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
         let opening = OPENING_STEPS as f64 * 0.002 * dexcube_sim::SUBSTEPS as f64;
         assert!(((sim.time() - began) - (opening + 4.0)).abs() < 1e-9);
     }
+    stages.stage1.driving = Driving {
+        stage1_control_rate: ControlRate::every(5).ok(),
+        stage1_steps: Some(150),
+        ..Driving::default()
+    };
+    let mut sim = Sim::new(Scene::load(SceneKind::Cube).unwrap());
+    set_up_scramble(&mut sim, &[], resting);
+    let run = stages.stage1.run(&mut sim, resting, target, &mut |_| {});
+    assert_eq!(
+        run.steps,
+        OPENING_STEPS + 4 * 150,
+        "150 of the paper's steps, 6 s"
+    );
     stages.stage1.policy.card.metadata["environment"]["control_substeps"] = 3.into();
     assert!(card_rate(&stages).is_err());
 }
