@@ -12,7 +12,7 @@ use clap::Args;
 use dexcube_cube::{CostTable, DistanceTable, scrambles_at_distance};
 use dexcube_env::{
     ControlRate, Info, ObjectKind, RecordedFailure, RecordedStart, RotMode, SimulatedEnv, StartMix,
-    StartPick, is_square,
+    StartPick, is_square, pose_goal,
 };
 use dexcube_operator::eval::{
     CubeResult, Hooks, PolicyFiles, markdown, plot, run_cube, table, wilson_interval,
@@ -23,7 +23,7 @@ use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::{file_beside, write_atomically};
 use dexcube_rl::policy::{PolicyCard, policy_file};
 use dexcube_rl::start_file::{StartsOrigin, save_starts};
-use dexcube_sim::cube::{read_puzzle, turned_since};
+use dexcube_sim::cube::{CubeState, read_puzzle, turned_since};
 use dexcube_sim::{Scene, SceneKind, Sim};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -768,7 +768,8 @@ pub struct EvalStageArgs {
     video: Option<PathBuf>,
     /// Also write one CSV row per episode: its number, seed (or recorded start), ending,
     /// final position and angle errors, whether the cube ended square and with a layer
-    /// turned, and its longest run of steps at the goal.
+    /// turned, its longest run of steps at the goal, its angle from the goal at the start,
+    /// and the first step that met the paper's test (empty if none did).
     #[arg(long, value_name = "FILE.csv")]
     episodes_csv: Option<PathBuf>,
 }
@@ -855,10 +856,18 @@ impl Ending {
 }
 
 /// One deterministic episode of an atomic action: its last step's info, whether the object
-/// ended square (a physical cube in its good state; any other object always), and the
-/// longest run of consecutive steps at the goal before the end (or before a drop).
+/// ended square (a physical cube in its good state; any other object always), the longest
+/// run of consecutive steps at the goal before the end (or before a drop), how far from the
+/// goal it began and the first step that met the paper's test.
 struct EpisodeTrace {
+    /// Stage 1 on the physical cube: the final angle from the goal with the cube's pose read
+    /// from all eight cubelets (`CubeState::mean_frame`) rather than DBL's alone.
+    mean_frame_angle_error: Option<f64>,
     info: Info,
+    /// The angle from the goal when the episode began (radians).
+    start_angle_error: f64,
+    /// The first control step (counted from 1) at the end of which the paper's test was met.
+    first_at_goal: Option<usize>,
     square: bool,
     /// The physical cube ended with a layer turned from where it began.
     turned_a_layer: bool,
@@ -867,19 +876,22 @@ struct EpisodeTrace {
     start: Option<RecordedStart>,
 }
 
-/// Runs a deterministic episode from `seed`, keeping where it began if `record`.
+/// Runs a deterministic episode from `seed`, keeping where it began if `record`; `posing` for
+/// Stage 1, whose goal is a pose.
 fn episode(
     env: &mut dyn SimulatedEnv,
     policy: &Policy,
     seed: u64,
     thresholds: (f64, f64),
     record: bool,
+    posing: bool,
     watch: &mut dyn FnMut(&mut Sim),
 ) -> EpisodeTrace {
-    let (mut obs, _) = env.reset(Some(seed));
+    let (mut obs, start_info) = env.reset(Some(seed));
     let start = record.then(|| env.fresh_start());
     let puzzle_at_start = read_puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
+    let (mut steps, mut first_at_goal) = (0, None);
     watch(env.sim_mut());
     let test = env.goal();
     loop {
@@ -888,17 +900,29 @@ fn episode(
             policy.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
         let t = env.step(&action);
         watch(env.sim_mut());
+        steps += 1;
         hold = if meets_paper_test(&t.info, thresholds) {
+            first_at_goal.get_or_insert(steps);
             hold + 1
         } else {
             0
         };
         longest_hold = longest_hold.max(hold);
         if t.terminated || t.truncated {
+            let mean_frame_angle_error =
+                CubeState::read(env.sim()).filter(|_| posing).map(|cube| {
+                    let mut achieved = t.observation.achieved_goal.clone();
+                    let pose = pose_goal(cube.pose().position, cube.mean_frame());
+                    achieved[..pose.len()].copy_from_slice(&pose);
+                    test.errors(&achieved, &t.observation.desired_goal).1
+                });
             return EpisodeTrace {
+                mean_frame_angle_error,
                 square: is_square(env.sim()),
                 turned_a_layer: turned_since(puzzle_at_start.as_ref(), env.sim()),
                 info: t.info,
+                start_angle_error: start_info.angle_error,
+                first_at_goal,
                 longest_hold,
                 start,
             };
@@ -987,6 +1011,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 episode_seed(k),
                 thresholds,
                 keep_starts,
+                args.stage == EnvKind::Rot,
                 &mut |_| {},
             );
             let turning = args.stage == EnvKind::Layer;
@@ -1015,15 +1040,20 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 }
             }
             if args.episodes_csv.is_some() {
+                let first_at_goal = trace.first_at_goal.map_or(String::new(), |s| s.to_string());
+                let mean_frame = trace
+                    .mean_frame_angle_error
+                    .map_or(String::new(), |e| format!("{e:.6}"));
                 let row = format!(
-                    "{k},{},{},{:.6},{:.6},{},{},{}",
+                    "{k},{},{},{:.6},{:.6},{},{},{},{:.6},{first_at_goal},{mean_frame}",
                     episode_seed(k),
                     ending.tag(),
                     trace.info.position_error,
                     trace.info.angle_error,
                     trace.square,
                     trace.turned_a_layer,
-                    trace.longest_hold
+                    trace.longest_hold,
+                    trace.start_angle_error,
                 );
                 rows.lock().expect("no thread panics").push((k, row));
             }
@@ -1038,8 +1068,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     )?;
     bar.finish_and_clear();
     if let Some(path) = &args.episodes_csv {
-        let header =
-            "episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold";
+        let header = "episode,seed,ending,position_error,angle_error,square,turned_a_layer,\
+                      longest_hold,start_angle_error,first_at_goal,mean_frame_angle_error";
         let mut lines = vec![header.to_string()];
         lines.extend(in_episode_order(rows));
         let text = lines.join("\n") + "\n";
@@ -1057,6 +1087,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             episode_seed(0),
             thresholds,
             false,
+            args.stage == EnvKind::Rot,
             watch,
         );
         video.save()?;

@@ -1245,16 +1245,23 @@ fn eval_stage_writes_a_video_of_its_first_episode() {
     );
 }
 
-/// `eval-stage --episodes-csv` writes one row per episode, in order, whose endings add up to
-/// the count it prints, and whose errors agree with each ending.
-#[test]
-fn eval_stage_writes_a_row_per_episode() {
-    let dir = fresh_dir("dexcube-cli-eval-stage-episodes");
+/// Runs `eval-stage STAGE` on `episodes` episodes from `seed` with `--episodes-csv`, and
+/// returns the rows under the CSV's header (which it checks) and what the command printed.
+fn episode_rows(stage: &str, seed: u64, episodes: usize) -> (Vec<Vec<String>>, String) {
+    let dir = fresh_dir(&format!("dexcube-cli-eval-stage-episodes-{stage}"));
     let csv = dir.join("episodes.csv");
     let policies = shipped_policy_flags();
+    let (seed, episodes) = (seed.to_string(), episodes.to_string());
     let args = [
-        &["eval-stage", "layer", "--episodes", "3", "--threads", "2"][..],
-        &["--seed", "8000014", "--episodes-csv", csv.to_str().unwrap()],
+        &[
+            "eval-stage",
+            stage,
+            "--episodes",
+            &episodes,
+            "--threads",
+            "2",
+        ][..],
+        &["--seed", &seed, "--episodes-csv", csv.to_str().unwrap()],
         &policies.each_ref().map(String::as_str),
     ]
     .concat();
@@ -1264,9 +1271,23 @@ fn eval_stage_writes_a_row_per_episode() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
-        Some("episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold")
+        Some(
+            "episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold,\
+             start_angle_error,first_at_goal,mean_frame_angle_error"
+        )
     );
-    let rows: Vec<Vec<&str>> = lines.map(|line| line.split(',').collect()).collect();
+    let rows = lines
+        .map(|line| line.split(',').map(String::from).collect())
+        .collect();
+    (rows, stdout(&o))
+}
+
+/// `eval-stage --episodes-csv` writes one row per episode, in order, whose endings add up to
+/// the count it prints, and whose errors agree with each ending: each begins a quarter turn
+/// from its goal, and a success first met the test no later than its final hold began.
+#[test]
+fn eval_stage_writes_a_row_per_episode() {
+    let (rows, printed) = episode_rows("layer", 8_000_014, 3);
     assert_eq!(rows.len(), 3);
     let mut successes = 0;
     for (k, row) in rows.iter().enumerate() {
@@ -1274,18 +1295,39 @@ fn eval_stage_writes_a_row_per_episode() {
         assert_eq!(row[1], (8_000_014 + k).to_string());
         let angle_error: f64 = row[4].parse().unwrap();
         let longest_hold: usize = row[7].parse().unwrap();
+        let start_angle_error: f64 = row[8].parse().unwrap();
+        assert!(
+            (start_angle_error - std::f64::consts::FRAC_PI_2).abs() < 0.02,
+            "{row:?}"
+        );
+        assert_eq!(row[10], "", "Stage 2's goal is no pose");
         if row[2] == "success" {
             successes += 1;
             assert!(angle_error < 0.1 && longest_hold >= 1, "{row:?}");
+            let first_at_goal: usize = row[9].parse().unwrap();
+            assert!(first_at_goal + longest_hold <= 101, "{row:?}");
         } else {
             assert!(angle_error >= 0.1 || row[2] == "dropped", "{row:?}");
         }
     }
     assert!(
-        stdout(&o).contains(&format!(": {successes}/3 = ")),
-        "{}",
-        stdout(&o)
+        printed.contains(&format!(": {successes}/3 = ")),
+        "{printed}"
     );
+}
+
+/// Stage 1's rows also give the final angle with the pose read from all eight cubelets: on
+/// a cube left square it is within a few hundredths of DBL's.
+#[test]
+fn eval_stage_rows_give_stage1_the_whole_cubes_angle() {
+    let (rows, _) = episode_rows("rot", 1_000_000, 2);
+    assert_eq!(rows.len(), 2);
+    for row in &rows {
+        let (dbl, mean): (f64, f64) = (row[4].parse().unwrap(), row[10].parse().unwrap());
+        if row[5] == "true" {
+            assert!((dbl - mean).abs() < 0.05, "{row:?}");
+        }
+    }
 }
 
 /// `goal-lead` writes a policy that `eval-stage` runs shown its goal led on, which a single

@@ -119,10 +119,24 @@ impl CubeState {
     /// angular velocity in the world frame. Both are means over its four cubelets.
     pub fn layer_behind(&self, face: Face) -> (Quat, [f64; 3]) {
         let axis = face_normal(face);
+        self.mean_frame_of(|home, snapped| !in_layer(snapped, home, axis))
+    }
+
+    /// The cube's orientation in the world as all eight cubelets carry it: the mean of the
+    /// frames each would give were it home. On a square cube it is DBL's, the cube frame; on a
+    /// cube with a layer or a cubelet out of line it splits the difference, where DBL's frame
+    /// follows that one cubelet.
+    pub fn mean_frame(&self) -> Quat {
+        self.mean_frame_of(|_, _| true).0
+    }
+
+    /// The mean over the cubelets `counted` (by home slot and snapped rotation) of the cube
+    /// frame each carries, in the world, and of their angular velocities in the world frame.
+    fn mean_frame_of(&self, counted: impl Fn(usize, &Quat) -> bool) -> (Quat, [f64; 3]) {
         let (mut sum, mut spin, mut n) = ([0.0; 4], [0.0; 3], 0.0);
         for (home, q) in self.rotations.iter().enumerate() {
             let (snapped, _) = rotation::snap_to_cube(q, rotation::cube_group());
-            if in_layer(&snapped, home, axis) {
+            if !counted(home, &snapped) {
                 continue;
             }
             // The cube frame carried by this cubelet: its rotation with its slot taken away.

@@ -1,7 +1,9 @@
 //! The physical cube's readout against the `cube` crate: kinematic turns, tumbling, pushes.
 
 use dexcube_cube::{Face, Facelets, Move, parse_moves};
-use dexcube_sim::cube::{CubeState, read_puzzle, turn_face, turn_face_by, turned_since};
+use dexcube_sim::cube::{
+    CubeState, face_normal, face_toward, read_puzzle, turn_face, turn_face_by, turned_since,
+};
 use dexcube_sim::rotation::{self, about};
 use dexcube_sim::{PhysicsScales, Pose, Scene, SceneKind, Sim};
 
@@ -133,6 +135,40 @@ fn partial_turns_show_as_layer_angle_and_misalignment() {
     turn_face_by(&mut sim, Face::U, -0.3 + 0.05);
     sim.forward();
     assert!(read(&sim).is_aligned());
+}
+
+/// The mean frame is DBL's on a square cube, and halfway between the layers when one is
+/// turned part-way, whether or not DBL's layer is the one that turned.
+#[test]
+fn the_mean_frame_splits_a_partial_turn_between_the_layers() {
+    let mut sim = cube_sim();
+    let tilted = rotation::normalise(&[0.8, 0.3, -0.4, 0.33]);
+    let mut pose = sim.object_pose();
+    pose.orientation = tilted;
+    sim.set_object_pose(&pose);
+    sim.forward();
+    let angle = rotation::angle_between;
+    assert!(angle(&read(&sim).mean_frame(), &tilted) < 1e-9);
+    for face in [Face::R, Face::L] {
+        // Turned as seen in the world; the layers are named in the cube's own frame.
+        let own = face_toward(&tilted, face_normal(face));
+        turn_face_by(&mut sim, face, 0.2);
+        sim.forward();
+        let state = read(&sim);
+        let mean = state.mean_frame();
+        // The two layers' frames, 0.2 apart; the one point 0.1 from each is halfway.
+        let (stayed, turned) = (
+            state.layer_behind(own).0,
+            state.layer_behind(own.opposite()).0,
+        );
+        assert!((angle(&stayed, &turned) - 0.2).abs() < 1e-6, "{face:?}");
+        for layer in [stayed, turned] {
+            assert!((angle(&mean, &layer) - 0.1).abs() < 1e-6, "{face:?}");
+        }
+        turn_face_by(&mut sim, face, -0.2);
+        sim.forward();
+        assert!(angle(&read(&sim).mean_frame(), &tilted) < 1e-9, "{face:?}");
+    }
 }
 
 /// The bodies of the named cubelets.
