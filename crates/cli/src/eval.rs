@@ -910,12 +910,15 @@ fn episode(
         longest_hold = longest_hold.max(hold);
         if t.terminated || t.truncated {
             let mean_frame_angle_error =
-                CubeState::read(env.sim()).filter(|_| posing).map(|cube| {
-                    let mut achieved = t.observation.achieved_goal.clone();
-                    let pose = pose_goal(cube.pose().position, cube.mean_frame());
-                    achieved[..pose.len()].copy_from_slice(&pose);
-                    test.errors(&achieved, &t.observation.desired_goal).1
-                });
+                posing
+                    .then(|| CubeState::read(env.sim()))
+                    .flatten()
+                    .map(|cube| {
+                        let mut achieved = t.observation.achieved_goal.clone();
+                        let pose = pose_goal(cube.pose().position, cube.mean_frame());
+                        achieved[..pose.len()].copy_from_slice(&pose);
+                        test.errors(&achieved, &t.observation.desired_goal).1
+                    });
             return EpisodeTrace {
                 mean_frame_angle_error,
                 square: is_square(env.sim()),
