@@ -100,8 +100,9 @@ pub struct OperatorArgs {
     pub stage1_control_rate: Option<ControlRate>,
     /// Run Stage 1 for up to this many control steps rather than its policy's episode (the
     /// paper's 100 at its rate), still ending once held: time for poses the policy reaches
-    /// late. Counted at the paper's rate, as --stage1-held is. Default: 200 planning for the hand (since session 47; 100 reproduces the
-    /// figures made before), the policy's episode with --paper-operator.
+    /// late. Counted at the paper's rate, as --stage1-held is. Default: 200 planning for the
+    /// hand (since session 47; 100 reproduces the figures made before), the policy's episode
+    /// with --paper-operator.
     #[arg(long, value_name = "STEPS", value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub stage1_steps: Option<u64>,
 }
@@ -998,6 +999,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         Some(_) => k as u64,
         None => args.seed + k as u64,
     };
+    // Stage 2 turns a layer; Stage 1 poses the cube.
+    let turning = args.stage == EnvKind::Layer;
     let bar = ProgressBar::new(episodes as u64);
     in_parallel(
         args.threads,
@@ -1014,10 +1017,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 episode_seed(k),
                 thresholds,
                 keep_starts,
-                args.stage == EnvKind::Rot,
+                !turning,
                 &mut |_| {},
             );
-            let turning = args.stage == EnvKind::Layer;
             let ending = Ending::of(&trace.info, thresholds, turning, trace.square);
             endings[ending as usize].fetch_add(1, Ordering::Relaxed);
             // What the recording counted as failing.
@@ -1090,7 +1092,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             episode_seed(0),
             thresholds,
             false,
-            args.stage == EnvKind::Rot,
+            !turning,
             watch,
         );
         video.save()?;

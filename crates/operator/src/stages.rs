@@ -78,10 +78,9 @@ pub struct Driving {
     /// Run Stage 1 for up to this many control steps rather than its policy's episode (4
     /// simulated seconds), still ending once held; counted at the paper's rate, as
     /// `stage1_held_steps` is, so that a faster rate gets as long. A third of the shipped
-    /// Stage 1's misses
-    /// from fresh placements reach the pose between steps 100 and 200. Planning for the hand
-    /// it is 200 (Table I, session 47 in `results/TRAINING.md`: as many cubes with rollback,
-    /// fewer actions, more open loop).
+    /// Stage 1's misses from fresh placements reach the pose between steps 100 and 200.
+    /// Planning for the hand it is 200 (Table I, session 47 in `results/TRAINING.md`: as many
+    /// cubes with rollback, fewer actions, more open loop).
     pub stage1_steps: Option<usize>,
 }
 
