@@ -745,6 +745,13 @@ pub struct EvalStageArgs {
     /// often. Record with seeds that no evaluation uses.
     #[arg(long, value_name = "FILE", conflicts_with = "starts")]
     record_starts: Option<PathBuf>,
+    /// Stage 1 only: also record, for every episode that missed its pose and kept the cube,
+    /// where it came closest to the pose (the physics state after the step with the smallest
+    /// angle from the goal, and the goal), marked failed, for `train --starts`: the states
+    /// this policy lost its pose from, or came nearest it and fell short, rather than where
+    /// the cube was placed.
+    #[arg(long, value_name = "FILE")]
+    record_closest: Option<PathBuf>,
     /// Let the policy act every N physics substeps of 2 ms (the paper's 20; fewer is a
     /// faster control rate), with as many more steps to an episode, so that each still
     /// lasts 4 simulated seconds; placements and settling are unchanged. N divides 20.
@@ -875,24 +882,35 @@ struct EpisodeTrace {
     longest_hold: usize,
     /// Where the episode began, when asked for (a fresh reset's).
     start: Option<RecordedStart>,
+    /// Where it came closest to its goal (the state after the step with the smallest angle
+    /// from it), when asked for; Stage 1 only, whose goal holds through the episode.
+    closest: Option<RecordedStart>,
 }
 
-/// Runs a deterministic episode from `seed`, keeping where it began if `record`; `posing` for
+/// What an episode keeps of its physics, for `--record-starts` and `--record-closest`.
+#[derive(Clone, Copy, Default)]
+struct Keep {
+    start: bool,
+    closest: bool,
+}
+
+/// Runs a deterministic episode from `seed`, keeping what `keep` asks for; `posing` for
 /// Stage 1, whose goal is a pose.
 fn episode(
     env: &mut dyn SimulatedEnv,
     policy: &Policy,
     seed: u64,
     thresholds: (f64, f64),
-    record: bool,
+    keep: Keep,
     posing: bool,
     watch: &mut dyn FnMut(&mut Sim),
 ) -> EpisodeTrace {
     let (mut obs, start_info) = env.reset(Some(seed));
-    let start = record.then(|| env.fresh_start());
+    let start = keep.start.then(|| env.fresh_start());
     let puzzle_at_start = read_puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
     let (mut steps, mut first_at_goal) = (0, None);
+    let (mut closest, mut closest_angle) = (None, f64::INFINITY);
     watch(env.sim_mut());
     let test = env.goal();
     loop {
@@ -909,6 +927,11 @@ fn episode(
             0
         };
         longest_hold = longest_hold.max(hold);
+        if keep.closest && t.info.angle_error < closest_angle {
+            closest_angle = t.info.angle_error;
+            // Stage 1's goal is the same at every step, so this restores the moment.
+            closest = Some(env.fresh_start());
+        }
         if t.terminated || t.truncated {
             let mean_frame_angle_error =
                 posing
@@ -929,6 +952,7 @@ fn episode(
                 first_at_goal,
                 longest_hold,
                 start,
+                closest,
             };
         }
         obs = t.observation;
@@ -963,6 +987,13 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     setup.episode_steps = args.episode_steps.map(|steps| steps as usize);
+    if args.record_closest.is_some() && args.stage != EnvKind::Rot {
+        bail!(
+            "--record-closest keeps Stage 1's states, whose goal holds through an episode; \
+             Stage 2 counts its goal from where the layer lay at the start: record Stage 2's \
+             inner states with the stage2_jams example's --keep-jams"
+        );
+    }
     if args.record && control_rate != setup.trained_rate {
         bail!(
             "--record writes the policy's evaluation at the rate it was trained at ({} \
@@ -993,7 +1024,11 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     });
     let failures_again = AtomicUsize::new(0);
     let rows = Mutex::new(Vec::new());
-    let (keep_starts, recorded) = (args.record_starts.is_some(), Mutex::new(Vec::new()));
+    let keep = Keep {
+        start: args.record_starts.is_some(),
+        closest: args.record_closest.is_some(),
+    };
+    let (recorded, recorded_closest) = (Mutex::new(Vec::new()), Mutex::new(Vec::new()));
     // Episode k begins from recorded start k, or from a fresh placement seeded seed + k.
     let episode_seed = |k: usize| match starts {
         Some(_) => k as u64,
@@ -1016,7 +1051,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 policy,
                 episode_seed(k),
                 thresholds,
-                keep_starts,
+                keep,
                 !turning,
                 &mut |_| {},
             );
@@ -1034,6 +1069,16 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             if let Some(start) = trace.start {
                 let start = RecordedStart { failed, ..start };
                 recorded.lock().expect("no thread panics").push((k, start));
+            }
+            if let Some(closest) = trace.closest
+                && !matches!(ending, Ending::Success | Ending::Dropped)
+            {
+                let closest = RecordedStart {
+                    failed: true,
+                    ..closest
+                };
+                let mut kept = recorded_closest.lock().expect("no thread panics");
+                kept.push((k, closest));
             }
             if ending == Ending::Success && !trace.square {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
@@ -1091,7 +1136,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             &policy,
             episode_seed(0),
             thresholds,
-            false,
+            Keep::default(),
             !turning,
             watch,
         );
@@ -1167,24 +1212,36 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             failures_again.into_inner()
         );
     }
-    if let Some(path) = &args.record_starts {
-        let starts = in_episode_order(recorded);
+    let save = |flag: &str, path: &Path, starts: &[RecordedStart]| {
         let origin = StartsOrigin {
             stage: args.stage.name().to_string(),
             failure,
             scene: object.scene().name().to_string(),
             command: format!(
-                "{} --record-starts {}",
+                "{} {flag} {}",
                 stage_command(&args, object, &prefix),
                 path.display()
             ),
         };
-        save_starts(path, &starts, &origin)?;
+        save_starts(path, starts, &origin)
+    };
+    if let Some(path) = &args.record_starts {
+        let starts = in_episode_order(recorded);
+        save("--record-starts", path, &starts)?;
         let failed = starts.iter().filter(|s| s.failed).count();
         println!(
             "  recorded the {} starts (from {failed} of which this policy {}) in {}",
             starts.len(),
             failure.describe(),
+            path.display()
+        );
+    }
+    if let Some(path) = &args.record_closest {
+        let closest = in_episode_order(recorded_closest);
+        save("--record-closest", path, &closest)?;
+        println!(
+            "  recorded where the {} misses that kept the cube came closest to their pose in {}",
+            closest.len(),
             path.display()
         );
     }

@@ -1245,23 +1245,18 @@ fn eval_stage_writes_a_video_of_its_first_episode() {
     );
 }
 
-/// Runs `eval-stage STAGE` on `episodes` episodes from `seed` with `--episodes-csv`, and
-/// returns the rows under the CSV's header (which it checks) and what the command printed.
-fn episode_rows(stage: &str, seed: u64, episodes: usize) -> (Vec<Vec<String>>, String) {
-    let dir = fresh_dir(&format!("dexcube-cli-eval-stage-episodes-{stage}"));
+/// Runs `eval-stage` with `args` (the stage first, then where its episodes come from and any
+/// other flags), the shipped policies and `--episodes-csv`, in a folder of its own named by
+/// `run`, and returns the rows under the CSV's header (which it checks) and what the command
+/// printed.
+fn episode_rows(run: &str, args: &[&str]) -> (Vec<Vec<String>>, String) {
+    let dir = fresh_dir(&format!("dexcube-cli-eval-stage-episodes-{run}"));
     let csv = dir.join("episodes.csv");
     let policies = shipped_policy_flags();
-    let (seed, episodes) = (seed.to_string(), episodes.to_string());
     let args = [
-        &[
-            "eval-stage",
-            stage,
-            "--episodes",
-            &episodes,
-            "--threads",
-            "2",
-        ][..],
-        &["--seed", &seed, "--episodes-csv", csv.to_str().unwrap()],
+        &["eval-stage"][..],
+        args,
+        &["--threads", "2", "--episodes-csv", csv.to_str().unwrap()],
         &policies.each_ref().map(String::as_str),
     ]
     .concat();
@@ -1287,7 +1282,7 @@ fn episode_rows(stage: &str, seed: u64, episodes: usize) -> (Vec<Vec<String>>, S
 /// from its goal, and a success first met the test no later than its final hold began.
 #[test]
 fn eval_stage_writes_a_row_per_episode() {
-    let (rows, printed) = episode_rows("layer", 8_000_014, 3);
+    let (rows, printed) = episode_rows("layer", &["layer", "--episodes", "3", "--seed", "8000014"]);
     assert_eq!(rows.len(), 3);
     let mut successes = 0;
     for (k, row) in rows.iter().enumerate() {
@@ -1320,7 +1315,7 @@ fn eval_stage_writes_a_row_per_episode() {
 /// a cube left square it is within a few hundredths of DBL's.
 #[test]
 fn eval_stage_rows_give_stage1_the_whole_cubes_angle() {
-    let (rows, _) = episode_rows("rot", 1_000_000, 2);
+    let (rows, _) = episode_rows("rot", &["rot", "--episodes", "2", "--seed", "1000000"]);
     assert_eq!(rows.len(), 2);
     for row in &rows {
         let (dbl, mean): (f64, f64) = (row[4].parse().unwrap(), row[10].parse().unwrap());
@@ -1328,6 +1323,79 @@ fn eval_stage_rows_give_stage1_the_whole_cubes_angle() {
             assert!((dbl - mean).abs() < 0.05, "{row:?}");
         }
     }
+}
+
+/// `eval-stage --record-closest` keeps, for each Stage 1 miss that kept the cube, where it
+/// came closest to its pose: one state for each such row of the episodes' CSV (not for the
+/// successes or the drop among these episodes), marked failed, and each no further from the
+/// pose than its episode ended. Stage 2, whose goal counts from the layer's start, is refused.
+#[test]
+fn eval_stage_records_where_stage1_misses_came_closest() {
+    let dir = fresh_dir("dexcube-cli-closest");
+    let file = dir.join("closest.safetensors");
+    let file = file.to_str().unwrap();
+    // Seed 14000000's first 12 episodes hold a drop and two misses of the angle.
+    let (rows, printed) = episode_rows(
+        "closest-fresh",
+        &["rot", "--episodes", "12", "--seed", "14000000"],
+    );
+    let (recorded, said) = episode_rows(
+        "closest-recorded",
+        &[
+            "rot",
+            "--episodes",
+            "12",
+            "--seed",
+            "14000000",
+            "--record-closest",
+            file,
+        ],
+    );
+    assert_eq!(recorded, rows, "recording changes no episode");
+    let misses: Vec<&Vec<String>> = rows
+        .iter()
+        .filter(|row| !["success", "dropped"].contains(&row[2].as_str()))
+        .collect();
+    assert!(
+        !misses.is_empty() && rows.iter().any(|row| row[2] == "dropped"),
+        "{printed}"
+    );
+    assert!(
+        said.contains(&format!("recorded where the {} misses", misses.len())),
+        "{said}"
+    );
+    let (replayed, said) = episode_rows("closest-replayed", &["rot", "--starts", file]);
+    assert_eq!(replayed.len(), misses.len(), "{said}");
+    assert!(
+        said.contains(&format!("missed the pose: {}; ", misses.len())),
+        "{said}"
+    );
+    for (start, miss) in replayed.iter().zip(&misses) {
+        let began: f64 = start[8].parse().unwrap();
+        let ended: f64 = miss[4].parse().unwrap();
+        assert!(
+            began <= ended,
+            "{start:?} began further off than {miss:?} ended"
+        );
+    }
+    let policies = shipped_policy_flags();
+    let layer = [
+        &[
+            "eval-stage",
+            "layer",
+            "--episodes",
+            "1",
+            "--record-closest",
+            file,
+        ][..],
+        &policies.each_ref().map(String::as_str),
+    ]
+    .concat();
+    assert_clean_failure(
+        &dexcube(&layer, ""),
+        2,
+        "--record-closest keeps Stage 1's states",
+    );
 }
 
 /// `goal-lead` writes a policy that `eval-stage` runs shown its goal led on, which a single
