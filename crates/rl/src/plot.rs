@@ -81,9 +81,9 @@ fn wrapped<DB: DrawingBackend>(
     Ok(lines)
 }
 
-/// Draws `series` against a shared x axis into a 1000x500 PNG, y from 0 to `y_max`, with the
-/// legend in a panel of its own on the right, where it cannot cover a curve. Series without
-/// points are left out.
+/// Draws `series` against a shared x axis into a 1000x500 PNG, y from 0 to `y_max`, under a
+/// title across the whole image, with the legend in a panel of its own on the right, where it
+/// cannot cover a curve. Series without points are left out.
 pub fn line_plot(
     path: &Path,
     title: &str,
@@ -102,9 +102,12 @@ pub fn line_plot(
     {
         let root = BitMapBackend::new(&temporary, (1000, 500)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (plot_area, legend_area) = root.split_horizontally(760);
+        // The title spans the whole image, so that a long one is not cut at the plot's edges.
+        let body = root
+            .titled(title, ("sans-serif", 22))
+            .map_err(|e| e.to_string())?;
+        let (plot_area, legend_area) = body.split_horizontally(760);
         let mut chart = ChartBuilder::on(&plot_area)
-            .caption(title, ("sans-serif", 22))
             .margin(15)
             .x_label_area_size(40)
             .y_label_area_size(55)
