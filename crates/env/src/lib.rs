@@ -164,6 +164,8 @@ pub trait SimulatedEnv: GoalEnv {
     /// Called right after a fresh reset (one not from a recorded start): the start that
     /// `reset_from` restores this episode from, bit for bit (its physics state and goal; not
     /// marked failed). `eval-stage --record-starts` keeps them, so that training can draw
-    /// again the fresh placements a policy failed from.
+    /// again the fresh placements a policy failed from. CubeRotEnv's goal holds through an
+    /// episode, so for Stage 1 it is also a start at any later step: `eval-stage
+    /// --record-closest` keeps the one nearest the pose.
     fn fresh_start(&self) -> RecordedStart;
 }
