@@ -114,6 +114,14 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
             setup.prefix.display()
         );
     }
+    if teacher.card.handover.is_some() {
+        bail!(
+            "{} hands stalled episodes to a member, which a student labelled step by step \
+             cannot learn from its actions: distil the ensemble it was made from (its card's \
+             metadata.handing_over names it)",
+            setup.prefix.display()
+        );
+    }
     let starts = match &args.starts {
         None => None,
         Some(path) => Some(StartMix {

@@ -668,9 +668,9 @@ fn fingerprint(path: &Path) -> anyhow::Result<String> {
 }
 
 /// A rerun may only continue PREFIX.csv if it was made with the same policies (by content:
-/// the weights, and a guide's or goal lead's settings from the card), seed and operator;
-/// PREFIX.run.json records them. More cubes per distance, or more distances, are fine:
-/// scrambles at a seed are prefix-stable.
+/// the weights, and a guide's, goal lead's or handover's settings from the card), seed and
+/// operator; PREFIX.run.json records them. More cubes per distance, or more distances, are
+/// fine: scrambles at a seed are prefix-stable.
 fn check_same_run(
     out: &Path,
     files: &PolicyFiles,
@@ -777,7 +777,9 @@ pub struct EvalStageArgs {
     /// Also write one CSV row per episode: its number, seed (or recorded start), ending,
     /// final position and angle errors, whether the cube ended square and with a layer
     /// turned, its longest run of steps at the goal, its angle from the goal at the start,
-    /// and the first step that met the paper's test (empty if none did).
+    /// the first step that met the paper's test (empty if none did), Stage 1's final angle
+    /// with the pose read from all eight cubelets (empty for the others), and whether an
+    /// ensemble that hands over (`dexcube handover`) handed the episode to its member.
     #[arg(long, value_name = "FILE.csv")]
     episodes_csv: Option<PathBuf>,
 }
@@ -885,6 +887,8 @@ struct EpisodeTrace {
     /// Where it came closest to its goal (the state after the step with the smallest angle
     /// from it), when asked for; Stage 1 only, whose goal holds through the episode.
     closest: Option<RecordedStart>,
+    /// An ensemble with a handover handed the episode to its member.
+    handed_over: bool,
 }
 
 /// What an episode keeps of its physics, for `--record-starts` and `--record-closest`.
@@ -913,10 +917,11 @@ fn episode(
     let (mut closest, mut closest_angle) = (None, f64::INFINITY);
     watch(env.sim_mut());
     let test = env.goal();
+    let mut acting = policy.episode();
     loop {
         let achieved = || obs.achieved_goal.clone();
         let action =
-            policy.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
+            acting.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
         let t = env.step(&action);
         watch(env.sim_mut());
         steps += 1;
@@ -953,6 +958,7 @@ fn episode(
                 longest_hold,
                 start,
                 closest,
+                handed_over: acting.handed_over(),
             };
         }
         obs = t.observation;
@@ -970,6 +976,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let wins_out_of_square = AtomicUsize::new(0);
     // Stage 1 episodes that kept the cube and ended with a layer turned, and of them successes.
     let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    // Episodes an ensemble handed to its member, and of them successes.
+    let (handovers, successes_handed_over) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
     let (thresholds, control_rate) = (setup.thresholds, setup.control_rate);
     if args.record && args.physics_spread > 0.0 {
@@ -1089,13 +1097,19 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     successes_with_layer_turns.fetch_add(1, Ordering::Relaxed);
                 }
             }
+            if trace.handed_over {
+                handovers.fetch_add(1, Ordering::Relaxed);
+                if ending == Ending::Success {
+                    successes_handed_over.fetch_add(1, Ordering::Relaxed);
+                }
+            }
             if args.episodes_csv.is_some() {
                 let first_at_goal = trace.first_at_goal.map_or(String::new(), |s| s.to_string());
                 let mean_frame = trace
                     .mean_frame_angle_error
                     .map_or(String::new(), |e| format!("{e:.6}"));
                 let row = format!(
-                    "{k},{},{},{:.6},{:.6},{},{},{},{:.6},{first_at_goal},{mean_frame}",
+                    "{k},{},{},{:.6},{:.6},{},{},{},{:.6},{first_at_goal},{mean_frame},{}",
                     episode_seed(k),
                     ending.tag(),
                     trace.info.position_error,
@@ -1104,6 +1118,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     trace.turned_a_layer,
                     trace.longest_hold,
                     trace.start_angle_error,
+                    trace.handed_over,
                 );
                 rows.lock().expect("no thread panics").push((k, row));
             }
@@ -1119,7 +1134,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     if let Some(path) = &args.episodes_csv {
         let header = "episode,seed,ending,position_error,angle_error,square,turned_a_layer,\
-                      longest_hold,start_angle_error,first_at_goal,mean_frame_angle_error";
+                      longest_hold,start_angle_error,first_at_goal,mean_frame_angle_error,handed_over";
         let mut lines = vec![header.to_string()];
         lines.extend(in_episode_order(rows));
         let text = lines.join("\n") + "\n";
@@ -1197,6 +1212,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             "  kept the cube but ended with a layer turned from where it began: {} ({} of them successes)",
             layer_turns.into_inner(),
             successes_with_layer_turns.into_inner()
+        );
+    }
+    if let Some(handover) = PolicyCard::read(&prefix)?.handover {
+        println!(
+            "  handed over to member {} in {} episodes ({} of them successes)",
+            handover.member,
+            handovers.into_inner(),
+            successes_handed_over.into_inner()
         );
     }
     for (count, steps) in held.iter().zip(HOLDS) {

@@ -52,6 +52,12 @@ enum Command {
     /// term adds to an error that persists. Writes a policy that loads and runs as any other;
     /// its weights are unchanged.
     GoalLead(train::GoalLeadArgs),
+    /// Lets an ensemble hand a stalled episode to one of its members: once the cube has gone
+    /// some steps neither meeting its test nor coming nearer its goal, that member acts alone
+    /// for the rest of the episode (where the members would turn the cube different ways,
+    /// their mean can turn it neither). Writes a policy that loads and runs as any other; its
+    /// weights are unchanged.
+    Handover(train::HandoverArgs),
     /// Teaches one actor to act as a stage policy does (an ensemble, typically) by DAgger:
     /// the teacher labels every state of episodes run first by itself, then by the student.
     Distil(distil::DistilArgs),
@@ -86,6 +92,7 @@ fn main() -> ExitCode {
         Command::Ensemble(args) => train::combine(train::Combination::Ensemble, args),
         Command::Guide(args) => train::guide(args),
         Command::GoalLead(args) => train::goal_lead(args),
+        Command::Handover(args) => train::handover(args),
         Command::Distil(args) => distil::run(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),

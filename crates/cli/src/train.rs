@@ -9,6 +9,7 @@ use clap::Args;
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{ControlRate, CubeRotEnv, GoalLead, LayerOpEnv, StartMix, StartPick};
 use dexcube_rl::checkpoint::CheckpointError;
+use dexcube_rl::handover::Handover;
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
@@ -312,6 +313,59 @@ pub fn goal_lead(args: GoalLeadArgs) -> anyhow::Result<ExitCode> {
         args.policy.display(),
         args.share,
         args.within,
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct HandoverArgs {
+    /// The ensemble (led on or not), as the path of its .safetensors and .json less the
+    /// extension.
+    policy: PathBuf,
+    /// The member handed over to, counted from 0 in the order the ensemble was made
+    /// (`models/rot`: 0 the seen run's `epoch-0047`, 1 `rot-dropw20`, 2 `rot-td3-19`).
+    #[arg(long)]
+    member: usize,
+    /// Control steps in a row without progress (or the test met) before handing over; 0
+    /// hands over at once, which acts as the member alone.
+    #[arg(long, default_value_t = 25)]
+    patience: usize,
+    /// How much nearer its goal than it has yet been (radians) the cube must come for a step
+    /// to count as progress.
+    #[arg(long, default_value_t = 0.05, value_name = "RAD", value_parser = handover_progress)]
+    progress: f64,
+    /// Where to write the result (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn handover_progress(text: &str) -> Result<f64, String> {
+    angle_flag("--progress", "", text)
+}
+
+pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
+    let command = format!(
+        "dexcube handover {} --member {} --patience {} --progress {} --out {}",
+        args.policy.display(),
+        args.member,
+        args.patience,
+        args.progress,
+        args.out.display()
+    );
+    let handover = Handover {
+        member: args.member,
+        patience: args.patience,
+        progress: args.progress,
+    };
+    Policy::handing_over(&args.policy, handover, &args.out, &command)?;
+    println!(
+        "{} handing a stalled episode to member {} (after {} steps without {} rad of progress) \
+         into {}",
+        args.policy.display(),
+        args.member,
+        args.patience,
+        args.progress,
         args.out.display()
     );
     Ok(ExitCode::SUCCESS)

@@ -1268,7 +1268,7 @@ fn episode_rows(run: &str, args: &[&str]) -> (Vec<Vec<String>>, String) {
         lines.next(),
         Some(
             "episode,seed,ending,position_error,angle_error,square,turned_a_layer,longest_hold,\
-             start_angle_error,first_at_goal,mean_frame_angle_error"
+             start_angle_error,first_at_goal,mean_frame_angle_error,handed_over"
         )
     );
     let rows = lines
@@ -1396,6 +1396,104 @@ fn eval_stage_records_where_stage1_misses_came_closest() {
         2,
         "--record-closest keeps Stage 1's states",
     );
+}
+
+/// `handover` writes an ensemble that `eval-stage` runs handing stalled episodes to a member:
+/// at once (a patience of 0) it runs each episode as that member alone, never (a patience
+/// longer than an episode) as the ensemble, and the CSV says which were handed over. A single
+/// policy and a member the ensemble lacks are refused, and so is distilling it.
+#[test]
+fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
+    let dir = fresh_dir("dexcube-cli-handover");
+    std::fs::create_dir_all(&dir).unwrap();
+    let [rot, member, layer] = ["rot", "rot-td3-19", "layer"].map(|name| models().join(name));
+    let [rot, member, layer] = [&rot, &member, &layer].map(|path| path.to_str().unwrap());
+    let handing = |patience: &str| {
+        let out = dir.join(format!("rot-hand-{patience}"));
+        let args = [
+            &["handover", rot, "--member", "2", "--patience", patience][..],
+            &["--out", out.to_str().unwrap()],
+        ]
+        .concat();
+        let o = dexcube(&args, "");
+        assert!(
+            o.status.success() && stdout(&o).contains("to member 2"),
+            "{}",
+            stderr(&o)
+        );
+        out.to_str().unwrap().to_string()
+    };
+    // Each episode's row less its last column, whether it was handed over, and that column.
+    let rows = |policy: &str| {
+        let csv = dir.join("episodes.csv");
+        let args = [
+            &["eval-stage", "rot", "--episodes", "2", "--threads", "2"][..],
+            &["--seed", "2000000", "--episodes-csv", csv.to_str().unwrap()],
+            &["--rot-policy", policy, "--layer-policy", layer],
+        ]
+        .concat();
+        let o = dexcube(&args, "");
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let split = |line: &str| {
+            let (row, handed) = line.rsplit_once(',').unwrap();
+            (row.to_string(), handed.to_string())
+        };
+        (
+            text.lines().skip(1).map(split).collect::<Vec<_>>(),
+            stdout(&o),
+        )
+    };
+    let (alone, _) = rows(member);
+    let (together, _) = rows(rot);
+    assert_ne!(
+        alone, together,
+        "the member acts otherwise than the ensemble"
+    );
+    let (at_once, printed) = rows(&handing("0"));
+    assert!(
+        printed.contains("handed over to member 2 in 2 episodes"),
+        "{printed}"
+    );
+    let episodes =
+        |rows: &[(String, String)]| rows.iter().map(|(row, _)| row.clone()).collect::<Vec<_>>();
+    let all_handed =
+        |rows: &[(String, String)], to: &str| rows.iter().all(|(_, handed)| handed == to);
+    assert!(all_handed(&at_once, "true") && all_handed(&alone, "false"));
+    assert_eq!(episodes(&at_once), episodes(&alone));
+    let (never, printed) = rows(&handing("1000"));
+    assert!(
+        printed.contains("handed over to member 2 in 0 episodes"),
+        "{printed}"
+    );
+    assert_eq!(never, together);
+    let (teacher, out) = (handing("5"), dir.join("student"));
+    let distil = [
+        &["distil", "rot", "--rot-policy", &teacher][..],
+        &["--layer-policy", layer, "--out", out.to_str().unwrap()],
+    ]
+    .concat();
+    assert_clean_failure(
+        &dexcube(&distil, ""),
+        2,
+        "hands stalled episodes to a member",
+    );
+    for (policy, member, says) in [
+        (
+            member,
+            "0",
+            "a single policy, with no member to hand over to",
+        ),
+        (rot, "3", "it has 3 members (0 to 2), not a member 3"),
+    ] {
+        let out = dir.join("refused");
+        let args = [
+            &["handover", policy, "--member", member][..],
+            &["--out", out.to_str().unwrap()],
+        ]
+        .concat();
+        assert_clean_failure(&dexcube(&args, ""), 2, says);
+    }
 }
 
 /// `goal-lead` writes a policy that `eval-stage` runs shown its goal led on, which a single

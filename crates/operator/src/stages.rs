@@ -335,6 +335,7 @@ impl Stage1 for PolicyStage1 {
             .stage1_steadying
             .map(|steadying| Steadier::new(steadying, position));
         let test = self.goal;
+        let mut acting = policy.episode();
         let act = |sim: &Sim| {
             steadied_action(steadier.as_mut(), sim, || {
                 let achieved = || {
@@ -342,7 +343,7 @@ impl Stage1 for PolicyStage1 {
                     achieved_goal(&test, sim, &pose_goal(pose.position, pose.orientation))
                 };
                 let observation = rot_observation(sim, view, None);
-                policy.act_toward(&observation, &goal, achieved, &test)
+                acting.act_toward(&observation, &goal, achieved, &test)
             })
         };
         drive(
@@ -471,13 +472,13 @@ impl Stage2 for PolicyStage2 {
         };
         let mut view = view.with_view(self.view);
         let (test, goal) = (self.goal, self.goal.desired(FRAC_PI_2));
-        let policy = &self.policy;
+        let mut acting = self.policy.episode();
         drive(
             sim,
             |sim| {
                 let observation = view.observe(sim);
                 let achieved = || test.achieved(view.turned(), cube_misalignment(sim));
-                policy.act_toward(&observation, &goal, achieved, &test)
+                acting.act_toward(&observation, &goal, achieved, &test)
             },
             self.resting_z,
             self.driving.gradual_opening,

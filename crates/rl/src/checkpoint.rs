@@ -28,9 +28,23 @@ pub fn file_beside(prefix: &Path, extension: &str, own: &[&str]) -> PathBuf {
 
 #[derive(Debug)]
 pub enum CheckpointError {
-    Io { path: PathBuf, message: String },
-    Corrupt { path: PathBuf, message: String },
-    Mismatch { path: PathBuf, message: String },
+    Io {
+        path: PathBuf,
+        message: String,
+    },
+    Corrupt {
+        path: PathBuf,
+        message: String,
+    },
+    Mismatch {
+        path: PathBuf,
+        message: String,
+    },
+    /// A policy that fits, asked to be made into one it cannot be (led on twice, say).
+    Refused {
+        path: PathBuf,
+        message: String,
+    },
 }
 
 impl fmt::Display for CheckpointError {
@@ -49,6 +63,9 @@ impl fmt::Display for CheckpointError {
                 "{} does not fit this network ({message}); it was saved with another configuration or environment",
                 path.display()
             ),
+            CheckpointError::Refused { path, message } => {
+                write!(f, "{} cannot be used so: {message}", path.display())
+            }
         }
     }
 }

@@ -24,6 +24,7 @@ pub mod checkpoint;
 pub mod config;
 pub mod distil;
 pub mod guide;
+pub mod handover;
 pub mod networks;
 pub mod normalizer;
 pub mod params;

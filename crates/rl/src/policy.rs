@@ -7,8 +7,9 @@
 //! `partner{i}.…`, their sizes and normalisers in the card's `partners`). It acts with the
 //! mean of its members' deterministic actions.
 //!
-//! A policy may be shown its goal led on ([`Policy::led`], [`GoalLead`]): its card says how,
-//! and whoever runs it acts through [`Policy::act_toward`], which applies it.
+//! A policy may be shown its goal led on ([`Policy::led`], [`GoalLead`]), and an ensemble may
+//! hand a stalled episode to one member ([`Policy::handing_over`], [`Handover`]): its card
+//! says how, and whoever runs it acts through [`Policy::episode`], which applies both.
 
 use std::path::{Path, PathBuf};
 
@@ -20,6 +21,7 @@ use crate::agent::{Agent, Dims, network_inputs};
 use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
 use crate::guide::{self, CriticGuide, GuideCard};
+use crate::handover::{Handover, HandoverWatch};
 use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
 use crate::params::{self, NamedTensor};
@@ -43,6 +45,9 @@ pub struct PolicyCard {
     /// paper's, which is shown its goal as it is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub goal_lead: Option<GoalLead>,
+    /// The member an ensemble hands a stalled episode to, and when; none for the paper's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub handover: Option<Handover>,
 }
 
 /// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
@@ -104,6 +109,24 @@ fn derived_metadata(
     })
 }
 
+/// Writes at `out` the policy at `policy` with its card changed by `change` (which refuses
+/// with a message saying why) and its weights as they were; the new card's metadata names the
+/// source under `key` and says `how` it was made, by `command`.
+fn restated(
+    policy: &Path,
+    (out, command): (&Path, &str),
+    (key, how): (&str, String),
+    change: impl FnOnce(&mut PolicyCard) -> Result<(), String>,
+) -> Result<(), CheckpointError> {
+    let (weights, mut card, tensors) = read_stored(policy)?;
+    change(&mut card).map_err(|message| CheckpointError::Refused {
+        path: weights.clone(),
+        message,
+    })?;
+    card.metadata = derived_metadata(&card, how, (key, policy), command);
+    store(out, &tensors, &card)
+}
+
 /// The same for a single policy, refusing an ensemble with a message saying it cannot be
 /// `used` ("averaged", "joined", "trained from"): whatever combines or trains from policies
 /// takes each member's one actor.
@@ -152,7 +175,8 @@ impl PolicyCard {
     }
 
     /// What on the card, besides the weights, decides how the policy acts: its guide's
-    /// settings (how many candidates, how far, drawn from which seed) and its goal lead.
+    /// settings (how many candidates, how far, drawn from which seed), its goal lead and its
+    /// handover.
     /// None for a policy that acts on its weights alone.
     pub fn acting_settings(&self) -> Option<serde_json::Value> {
         let mut settings = serde_json::Map::new();
@@ -168,6 +192,9 @@ impl PolicyCard {
         }
         if let Some(lead) = &self.goal_lead {
             settings.insert("goal_lead".into(), serde_json::json!(lead));
+        }
+        if let Some(handover) = &self.handover {
+            settings.insert("handover".into(), serde_json::json!(handover));
         }
         (!settings.is_empty()).then_some(serde_json::Value::Object(settings))
     }
@@ -204,6 +231,7 @@ impl Policy {
             partners: Vec::new(),
             guide: None,
             goal_lead: None,
+            handover: None,
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -385,23 +413,56 @@ impl Policy {
         out: &Path,
         command: &str,
     ) -> Result<(), CheckpointError> {
-        let (weights, card, tensors) = read_stored(policy)?;
-        if card.goal_lead.is_some() {
-            return Err(mismatch(
-                &weights,
-                "its goal is led on already: lead the policy it was made from".to_string(),
-            ));
-        }
         let how = format!(
             "its goal led on by {} within {} rad",
             lead.share, lead.within
         );
-        let card = PolicyCard {
-            metadata: derived_metadata(&card, how, ("led", policy), command),
-            goal_lead: Some(lead),
-            ..card
-        };
-        store(out, &tensors, &card)
+        restated(policy, (out, command), ("led", how), |card| {
+            if card.goal_lead.is_some() {
+                return Err("its goal is led on already: lead the policy it was made from".into());
+            }
+            card.goal_lead = Some(lead);
+            Ok(())
+        })
+    }
+
+    /// Writes at `out` the ensemble at `policy` (led on or not) handing a stalled episode to
+    /// one member as `handover` says ([`Handover`]); its weights are unchanged. The card records
+    /// the ensemble and `command`, the command that made it.
+    pub fn handing_over(
+        policy: &Path,
+        handover: Handover,
+        out: &Path,
+        command: &str,
+    ) -> Result<(), CheckpointError> {
+        let how = format!(
+            "handing over to member {} after {} steps without {} rad of progress",
+            handover.member, handover.patience, handover.progress
+        );
+        restated(policy, (out, command), ("handing_over", how), |card| {
+            if card.handover.is_some() {
+                return Err(
+                    "it hands over already: start from the ensemble it was made from".into(),
+                );
+            }
+            let members = 1 + card.partners.len();
+            if members == 1 {
+                return Err(
+                    "it is a single policy, with no member to hand over to: make an \
+                            ensemble first (`dexcube ensemble`)"
+                        .into(),
+                );
+            }
+            if handover.member >= members {
+                return Err(format!(
+                    "it has {members} members (0 to {}), not a member {}",
+                    members - 1,
+                    handover.member
+                ));
+            }
+            card.handover = Some(handover);
+            Ok(())
+        })
     }
 
     /// Loads the policy at `prefix` onto `device`.
@@ -451,6 +512,7 @@ impl Policy {
                 partners: Vec::new(),
                 guide: None,
                 goal_lead: None,
+                handover: None,
                 ..self.card.clone()
             },
             actor,
@@ -478,39 +540,21 @@ impl Policy {
         1 + self.partners.len()
     }
 
-    /// The deterministic action toward `desired` for one observation, judged by `test`: shown
-    /// the goal led on where the card says so, from the object's goal now, which `achieved`
-    /// reads only then; else `desired` itself.
-    pub fn act_toward(
-        &self,
-        observation: &[f64],
-        desired: &[f64],
-        achieved: impl FnOnce() -> Vec<f64>,
-        test: &dyn Goal,
-    ) -> Vec<f64> {
-        match self.card.goal_lead {
-            Some(lead) => self.act(observation, &test.led(&achieved(), desired, lead)),
-            None => self.act(observation, desired),
+    /// The policy acting through one episode, as its card says: shown its goal led on, and
+    /// handing over when stalled, where it says so.
+    pub fn episode(&self) -> Acting<'_> {
+        Acting {
+            policy: self,
+            watch: self.card.handover.map(HandoverWatch::new),
         }
     }
 
     /// The deterministic action for one observation and the goal it is shown: an ensemble's is
     /// the mean of its members'.
     pub fn act(&self, observation: &[f64], goal: &[f64]) -> Vec<f64> {
-        let card = &self.card;
-        let mut total = self.member_action(
-            &self.actor,
-            (&card.observation_norm, &card.goal_norm),
-            observation,
-            goal,
-        );
-        for (actor, partner) in self.partners.iter().zip(&card.partners) {
-            let action = self.member_action(
-                actor,
-                (&partner.observation_norm, &partner.goal_norm),
-                observation,
-                goal,
-            );
+        let mut total = self.member_action(0, observation, goal);
+        for member in 1..self.members() {
+            let action = self.member_action(member, observation, goal);
             total.iter_mut().zip(action).for_each(|(t, a)| *t += a);
         }
         let scale = 1.0 / self.members() as f64;
@@ -521,14 +565,18 @@ impl Policy {
         }
     }
 
-    /// One actor's action, from the leading part of the observation that its normaliser takes.
-    fn member_action(
-        &self,
-        actor: &Mlp,
-        (observation_norm, goal_norm): (&Normalizer, &Normalizer),
-        observation: &[f64],
-        goal: &[f64],
-    ) -> Vec<f64> {
+    /// Member `member`'s action alone (0 is the first), from the leading part of the
+    /// observation that its normaliser takes.
+    fn member_action(&self, member: usize, observation: &[f64], goal: &[f64]) -> Vec<f64> {
+        let card = &self.card;
+        let (actor, observation_norm, goal_norm) = match member {
+            0 => (&self.actor, &card.observation_norm, &card.goal_norm),
+            k => {
+                let partner = &card.partners[k - 1];
+                let norms = (&partner.observation_norm, &partner.goal_norm);
+                (&self.partners[k - 1], norms.0, norms.1)
+            }
+        };
         let x = network_inputs(
             observation_norm,
             goal_norm,
@@ -539,5 +587,49 @@ impl Policy {
         );
         let out = actor.forward(x).tanh().into_data().convert::<f64>();
         out.try_to_vec::<f64>().unwrap_or_default()
+    }
+}
+
+/// A policy acting through one episode ([`Policy::episode`]): what its handover watches of it.
+pub struct Acting<'a> {
+    policy: &'a Policy,
+    watch: Option<HandoverWatch>,
+}
+
+impl Acting<'_> {
+    /// The deterministic action toward `desired` for one observation, judged by `test`: shown
+    /// the goal led on where the card says so, from the object's goal now, and by the member
+    /// handed over to once the episode has stalled, where it says so; `achieved` reads the
+    /// object's goal only for these.
+    pub fn act_toward(
+        &mut self,
+        observation: &[f64],
+        desired: &[f64],
+        achieved: impl FnOnce() -> Vec<f64>,
+        test: &dyn Goal,
+    ) -> Vec<f64> {
+        let policy = self.policy;
+        let lead = policy.card.goal_lead;
+        if lead.is_none() && self.watch.is_none() {
+            return policy.act(observation, desired);
+        }
+        let now = achieved();
+        let shown = match lead {
+            Some(lead) => test.led(&now, desired, lead),
+            None => desired.to_vec(),
+        };
+        let handed = self.watch.as_mut().is_some_and(|watch| {
+            let met = test.is_success(&now, desired);
+            watch.member_acts(test.errors(&now, desired).1, met)
+        });
+        match policy.card.handover {
+            Some(handover) if handed => policy.member_action(handover.member, observation, &shown),
+            _ => policy.act(observation, &shown),
+        }
+    }
+
+    /// Whether the episode has been handed to a member.
+    pub fn handed_over(&self) -> bool {
+        self.watch.as_ref().is_some_and(HandoverWatch::handed_over)
     }
 }

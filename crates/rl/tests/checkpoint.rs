@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use dexcube_env::{Goal, GoalEnv, GoalLead, Info, Observation, Spaces, Transition};
+use dexcube_rl::handover::Handover;
 use dexcube_rl::params::NamedTensor;
 use dexcube_rl::point_mass::{PointGoal, PointMassEnv};
 use dexcube_rl::{Agent, DdpgHerConfig, Policy, TrainOptions, train};
@@ -922,12 +923,15 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
         let (achieved, desired) = (&obs.achieved_goal, &obs.desired_goal);
         let shown = test.led(achieved, desired, lead);
         assert_eq!(
-            led.act_toward(&obs.observation, desired, || achieved.clone(), &test),
+            led.episode()
+                .act_toward(&obs.observation, desired, || achieved.clone(), &test),
             plain.act(&obs.observation, &shown)
         );
         let unread = || -> Vec<f64> { panic!("a policy without a lead reads no achieved goal") };
         assert_eq!(
-            plain.act_toward(&obs.observation, desired, unread, &test),
+            plain
+                .episode()
+                .act_toward(&obs.observation, desired, unread, &test),
             plain.act(&obs.observation, desired),
             "a policy without a lead is shown its goal as it is"
         );
@@ -946,6 +950,81 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
         let again = Policy::load(&dir.join(named), &device).unwrap();
         assert_eq!(again.card.goal_lead, Some(lead), "{named}");
     }
+}
+
+/// An ensemble that hands over acts as the ensemble until its episode has stalled for its
+/// patience, then as its member to the end; a fresh episode begins as the ensemble again. A
+/// single policy, a member it lacks and a second handover are refused.
+#[test]
+fn an_ensemble_hands_a_stalled_episode_to_its_member() {
+    let dir = fresh_dir("dexcube-rl-handover");
+    train(PointMassEnv::default, config(), &options(&dir, 4, false)).unwrap();
+    let device = burn::prelude::Device::flex();
+    let members = [
+        dir.join("snapshots/epoch-0001"),
+        dir.join("snapshots/epoch-0003"),
+    ];
+    let ensemble = dir.join("ensemble");
+    Policy::ensemble(&members, &ensemble, "dexcube ensemble ...").unwrap();
+    let handing = |member: usize, patience: usize| {
+        let out = dir.join(format!("hand{member}-{patience}"));
+        let handover = Handover {
+            member,
+            patience,
+            progress: 0.05,
+        };
+        Policy::handing_over(&ensemble, handover, &out, "dexcube handover ...").map(|()| out)
+    };
+    let (together, second) = (
+        Policy::load(&ensemble, &device).unwrap(),
+        Policy::load(&members[1], &device).unwrap(),
+    );
+    let hands = Policy::load(&handing(1, 2).unwrap(), &device).unwrap();
+    assert_eq!(
+        hands.card.metadata["handing_over"],
+        ensemble.display().to_string()
+    );
+    let test = dexcube_env::LayerGoal::square();
+    let mut env = PointMassEnv::default();
+    let (obs, _) = env.reset(Some(3));
+    let (achieved, desired) = (&obs.achieved_goal, &obs.desired_goal);
+    assert!(!test.is_success(achieved, desired));
+    let (as_ensemble, as_member) = (
+        together.act(&obs.observation, desired),
+        second.act(&obs.observation, desired),
+    );
+    assert_ne!(as_ensemble, as_member, "the members differ");
+    for _episode in 0..2 {
+        let mut acting = hands.episode();
+        // The cube never moves: the first step is progress, the next two stall.
+        for step in 1..=5 {
+            let action = acting.act_toward(&obs.observation, desired, || achieved.clone(), &test);
+            let (expected, handed) = if step < 3 {
+                (&as_ensemble, false)
+            } else {
+                (&as_member, true)
+            };
+            assert_eq!(&action, expected, "step {step}");
+            assert_eq!(acting.handed_over(), handed, "step {step}");
+        }
+    }
+    let at_once = Policy::load(&handing(1, 0).unwrap(), &device).unwrap();
+    let mut acting = at_once.episode();
+    let action = acting.act_toward(&obs.observation, desired, || achieved.clone(), &test);
+    assert_eq!(action, as_member, "a patience of 0 is the member alone");
+
+    let refusal = |from: &std::path::Path| {
+        let handover = hands.card.handover.unwrap();
+        let result = Policy::handing_over(from, handover, &dir.join("x"), "");
+        result.err().unwrap().to_string()
+    };
+    assert!(refusal(&dir.join("hand1-2")).contains("hands over already"));
+    assert!(refusal(&members[1]).contains("single policy, with no member"));
+    let lacking = handing(2, 5).err().unwrap().to_string();
+    assert!(
+        lacking.contains("2 members (0 to 1), not a member 2"),
+        "{lacking}"
+    );
 }
 
 /// The outputs of `net` on a fixed batch of `inputs`-long rows.

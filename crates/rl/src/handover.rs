@@ -1,0 +1,115 @@
+//! When an ensemble hands its episode to one of its members ([`Handover`]), and the watch
+//! that decides it through one episode ([`HandoverWatch`]).
+//!
+//! An ensemble acts with the mean of its members' actions. Where the members would turn the
+//! cube different ways, the mean can turn it neither way, and the cube stalls: session 50 in
+//! `results/TRAINING.md` found the states where `models/rot` stayed stuck more than half a
+//! radian from its pose are ones each member alone mostly leaves. A policy with a handover
+//! acts as the ensemble until the cube has stalled, then as the one member for the rest of
+//! the episode.
+
+use serde::{Deserialize, Serialize};
+
+/// Hands the episode to member `member` (0 is the first) once the cube has gone `patience`
+/// control steps in a row neither meeting its test nor coming `progress` radians nearer its
+/// goal than it has yet been. A patience of 0 hands over before the first step: the member
+/// alone.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Handover {
+    pub member: usize,
+    pub patience: usize,
+    pub progress: f64,
+}
+
+/// What a handover keeps of one episode: the nearest the cube has come to its goal, how many
+/// steps it has stalled since, and whether the member has taken over.
+#[derive(Clone, Debug)]
+pub struct HandoverWatch {
+    handover: Handover,
+    nearest: f64,
+    stalled: usize,
+    handed_over: bool,
+}
+
+impl HandoverWatch {
+    pub fn new(handover: Handover) -> HandoverWatch {
+        HandoverWatch {
+            handover,
+            nearest: f64::INFINITY,
+            stalled: 0,
+            handed_over: false,
+        }
+    }
+
+    /// Reads the step about to be acted on, the cube `angle` radians from its goal and
+    /// `met` when it meets its test, and says whether the member acts on it. Once handed
+    /// over, the member acts to the end of the episode.
+    pub fn member_acts(&mut self, angle: f64, met: bool) -> bool {
+        let Handover {
+            patience, progress, ..
+        } = self.handover;
+        let nearer = angle < self.nearest - progress;
+        if nearer {
+            self.nearest = angle;
+        }
+        if !self.handed_over {
+            self.stalled = if met || nearer { 0 } else { self.stalled + 1 };
+            self.handed_over = self.stalled >= patience;
+        }
+        self.handed_over
+    }
+
+    pub fn handed_over(&self) -> bool {
+        self.handed_over
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn watch(patience: usize) -> HandoverWatch {
+        HandoverWatch::new(Handover {
+            member: 1,
+            patience,
+            progress: 0.05,
+        })
+    }
+
+    #[test]
+    fn hands_over_after_patience_steps_without_progress_and_stays_handed_over() {
+        let mut w = watch(3);
+        // Coming nearer by more than the progress each step: never stalled.
+        for angle in [1.5, 1.4, 1.3, 1.2] {
+            assert!(!w.member_acts(angle, false));
+        }
+        // Nearer by less than the progress counts as stalled: the third such step hands over.
+        assert!(!w.member_acts(1.18, false));
+        assert!(!w.member_acts(1.17, false));
+        assert!(w.member_acts(1.16, false));
+        // Once handed over, even progress and the test met keep the member acting.
+        assert!(w.member_acts(0.2, false) && w.member_acts(0.0, true));
+        assert!(w.handed_over());
+    }
+
+    #[test]
+    fn a_cube_at_its_goal_is_not_stalled() {
+        let mut w = watch(2);
+        assert!(!w.member_acts(0.5, false));
+        for _ in 0..50 {
+            assert!(
+                !w.member_acts(0.05, true),
+                "holding the goal is not stalling"
+            );
+        }
+        // Lost from the goal and not coming back within 0.05 rad of the nearest (0.05).
+        assert!(!w.member_acts(0.15, false));
+        assert!(w.member_acts(0.15, false));
+    }
+
+    #[test]
+    fn a_patience_of_zero_hands_over_before_the_first_step() {
+        let mut w = watch(0);
+        assert!(w.member_acts(1.0, false));
+    }
+}
