@@ -752,6 +752,12 @@ pub struct EvalStageArgs {
     /// the cube was placed.
     #[arg(long, value_name = "FILE")]
     record_closest: Option<PathBuf>,
+    /// Stage 1 only, for an ensemble that hands over (`dexcube handover`): also record, for
+    /// every episode it handed to its member, the physics state the member first acted from,
+    /// and the goal, marked failed where the episode then failed, for `train --starts`: where
+    /// the member is handed the cube.
+    #[arg(long, value_name = "FILE")]
+    record_handovers: Option<PathBuf>,
     /// Let the policy act every N physics substeps of 2 ms (the paper's 20; fewer is a
     /// faster control rate), with as many more steps to an episode, so that each still
     /// lasts 4 simulated seconds; placements and settling are unchanged. N divides 20.
@@ -887,15 +893,20 @@ struct EpisodeTrace {
     /// Where it came closest to its goal (the state after the step with the smallest angle
     /// from it), when asked for; Stage 1 only, whose goal holds through the episode.
     closest: Option<RecordedStart>,
+    /// Where an ensemble that hands over handed the episode to its member, when asked for;
+    /// Stage 1 only, as for `closest`.
+    handover: Option<RecordedStart>,
     /// An ensemble with a handover handed the episode to its member.
     handed_over: bool,
 }
 
-/// What an episode keeps of its physics, for `--record-starts` and `--record-closest`.
+/// What an episode keeps of its physics, for `--record-starts`, `--record-closest` and
+/// `--record-handovers`.
 #[derive(Clone, Copy, Default)]
 struct Keep {
     start: bool,
     closest: bool,
+    handover: bool,
 }
 
 /// Runs a deterministic episode from `seed`, keeping what `keep` asks for; `posing` for
@@ -915,6 +926,7 @@ fn episode(
     let (mut hold, mut longest_hold) = (0, 0);
     let (mut steps, mut first_at_goal) = (0, None);
     let (mut closest, mut closest_angle) = (None, f64::INFINITY);
+    let mut handover = None;
     watch(env.sim_mut());
     let test = env.goal();
     let mut acting = policy.episode();
@@ -922,6 +934,10 @@ fn episode(
         let achieved = || obs.achieved_goal.clone();
         let action =
             acting.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
+        if keep.handover && handover.is_none() && acting.handed_over() {
+            // The state the member first acts from, before its first step.
+            handover = Some(env.fresh_start());
+        }
         let t = env.step(&action);
         watch(env.sim_mut());
         steps += 1;
@@ -958,6 +974,7 @@ fn episode(
                 longest_hold,
                 start,
                 closest,
+                handover,
                 handed_over: acting.handed_over(),
             };
         }
@@ -995,12 +1012,17 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     setup.episode_steps = args.episode_steps.map(|steps| steps as usize);
-    if args.record_closest.is_some() && args.stage != EnvKind::Rot {
-        bail!(
-            "--record-closest keeps Stage 1's states, whose goal holds through an episode; \
-             Stage 2 counts its goal from where the layer lay at the start: record Stage 2's \
-             inner states with the stage2_jams example's --keep-jams"
-        );
+    for (flag, asked) in [
+        ("--record-closest", args.record_closest.is_some()),
+        ("--record-handovers", args.record_handovers.is_some()),
+    ] {
+        if asked && args.stage != EnvKind::Rot {
+            bail!(
+                "{flag} keeps Stage 1's states, whose goal holds through an episode; Stage 2 \
+                 counts its goal from where the layer lay at the start: record Stage 2's inner \
+                 states with the stage2_jams example's --keep-jams"
+            );
+        }
     }
     if args.record && control_rate != setup.trained_rate {
         bail!(
@@ -1010,6 +1032,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let (prefix, object, scene) = (setup.prefix.clone(), setup.object, setup.scene.clone());
+    let handover = PolicyCard::read(&prefix)?.handover;
+    if args.record_handovers.is_some() && handover.is_none() {
+        bail!(
+            "--record-handovers keeps where an ensemble hands an episode to its member, and {} \
+             hands none over: make one that does with `dexcube handover`",
+            prefix.display()
+        );
+    }
     let (starts, failure) = match &args.starts {
         None => (None, args.stage.recorded_failure()),
         Some(path) => {
@@ -1035,8 +1065,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let keep = Keep {
         start: args.record_starts.is_some(),
         closest: args.record_closest.is_some(),
+        handover: args.record_handovers.is_some(),
     };
     let (recorded, recorded_closest) = (Mutex::new(Vec::new()), Mutex::new(Vec::new()));
+    let recorded_handovers = Mutex::new(Vec::new());
     // Episode k begins from recorded start k, or from a fresh placement seeded seed + k.
     let episode_seed = |k: usize| match starts {
         Some(_) => k as u64,
@@ -1087,6 +1119,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 };
                 let mut kept = recorded_closest.lock().expect("no thread panics");
                 kept.push((k, closest));
+            }
+            if let Some(handover) = trace.handover {
+                let handover = RecordedStart {
+                    failed: ending != Ending::Success,
+                    ..handover
+                };
+                let mut kept = recorded_handovers.lock().expect("no thread panics");
+                kept.push((k, handover));
             }
             if ending == Ending::Success && !trace.square {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
@@ -1214,7 +1254,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             successes_with_layer_turns.into_inner()
         );
     }
-    if let Some(handover) = PolicyCard::read(&prefix)?.handover {
+    if let Some(handover) = handover {
         println!(
             "  handed over to member {} in {} episodes ({} of them successes)",
             handover.member,
@@ -1265,6 +1305,16 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         println!(
             "  recorded where the {} misses that kept the cube came closest to their pose in {}",
             closest.len(),
+            path.display()
+        );
+    }
+    if let Some(path) = &args.record_handovers {
+        let handovers = in_episode_order(recorded_handovers);
+        save("--record-handovers", path, &handovers)?;
+        let failed = handovers.iter().filter(|s| s.failed).count();
+        println!(
+            "  recorded where the {} episodes handed over ({failed} of them failed) were handed to the member in {}",
+            handovers.len(),
             path.display()
         );
     }

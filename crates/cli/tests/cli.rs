@@ -1496,6 +1496,104 @@ fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
     }
 }
 
+/// `eval-stage --record-handovers` keeps the state where an ensemble handed each episode to its
+/// member, marked failed where the episode failed: handed over at once, the member alone run
+/// from those states ends every episode as it ends from the fresh placements. A policy that
+/// hands none over, and Stage 2, are refused.
+#[test]
+fn eval_stage_records_where_an_ensemble_hands_over() {
+    let dir = fresh_dir("dexcube-cli-record-handovers");
+    std::fs::create_dir_all(&dir).unwrap();
+    let [rot, member, layer] = ["rot", "rot-td3-19", "layer"].map(|name| models().join(name));
+    let [rot, member, layer] = [&rot, &member, &layer].map(|path| path.to_str().unwrap());
+    let (at_once, file) = (dir.join("rot-hand-0"), dir.join("handovers.safetensors"));
+    let [at_once, file] = [&at_once, &file].map(|path| path.to_str().unwrap());
+    let made = dexcube(
+        &[
+            "handover",
+            rot,
+            "--member",
+            "2",
+            "--patience",
+            "0",
+            "--out",
+            at_once,
+        ],
+        "",
+    );
+    assert!(made.status.success(), "{}", stderr(&made));
+    let run = |policy: &str, from: &[&str], csv: &str| {
+        let csv = dir.join(csv);
+        let args = [
+            &["eval-stage", "rot", "--episodes", "3", "--threads", "2"][..],
+            from,
+            &["--rot-policy", policy, "--layer-policy", layer],
+            &["--episodes-csv", csv.to_str().unwrap()],
+        ]
+        .concat();
+        let o = dexcube(&args, "");
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let endings: Vec<String> = text
+            .lines()
+            .skip(1)
+            .map(|line| line.splitn(3, ',').nth(2).unwrap().to_string())
+            .collect();
+        (endings, stdout(&o))
+    };
+    let fresh = ["--seed", "2000000"];
+    let (handed, printed) = run(
+        at_once,
+        &[&fresh[..], &["--record-handovers", file]].concat(),
+        "a.csv",
+    );
+    let failures = handed
+        .iter()
+        .filter(|row| !row.starts_with("success"))
+        .count();
+    assert!(
+        printed.contains(&format!(
+            "the 3 episodes handed over ({failures} of them failed)"
+        )),
+        "{printed}"
+    );
+    let (replayed, printed) = run(member, &["--starts", file], "b.csv");
+    assert!(
+        printed.contains(&format!("dropped the cube or missed the pose: {failures};")),
+        "{printed}"
+    );
+    let (alone, _) = run(member, &fresh, "c.csv");
+    // Less the last column, which says whether the episode was handed over.
+    let less_last = |rows: &[String]| -> Vec<String> {
+        rows.iter()
+            .map(|row| row.rsplit_once(',').unwrap().0.to_string())
+            .collect()
+    };
+    assert_eq!(less_last(&replayed), less_last(&alone));
+    assert_eq!(less_last(&handed), less_last(&alone));
+    let refused = |stage: &str, policy: &str| {
+        let args = [
+            &[
+                "eval-stage",
+                stage,
+                "--episodes",
+                "1",
+                "--rot-policy",
+                policy,
+            ][..],
+            &["--layer-policy", layer, "--record-handovers", file],
+        ]
+        .concat();
+        dexcube(&args, "")
+    };
+    assert_clean_failure(&refused("rot", rot), 2, "hands none over");
+    assert_clean_failure(
+        &refused("layer", at_once),
+        2,
+        "--record-handovers keeps Stage 1's states",
+    );
+}
+
 /// `goal-lead` writes a policy that `eval-stage` runs shown its goal led on, which a single
 /// episode tells from the policy it was made from; bad settings and combining it are refused.
 #[test]
