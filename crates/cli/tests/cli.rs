@@ -1245,24 +1245,34 @@ fn eval_stage_writes_a_video_of_its_first_episode() {
     );
 }
 
+/// Runs `eval-stage` with `args` and `--episodes-csv csv`, checks that it succeeded, and
+/// returns the CSV's text and what the command printed.
+fn eval_stage_csv(csv: &std::path::Path, args: &[&str]) -> (String, String) {
+    let args = [
+        &["eval-stage"][..],
+        args,
+        &["--episodes-csv", csv.to_str().unwrap()],
+    ]
+    .concat();
+    let o = dexcube(&args, "");
+    assert!(o.status.success(), "{}", stderr(&o));
+    (std::fs::read_to_string(csv).unwrap(), stdout(&o))
+}
+
 /// Runs `eval-stage` with `args` (the stage first, then where its episodes come from and any
 /// other flags), the shipped policies and `--episodes-csv`, in a folder of its own named by
 /// `run`, and returns the rows under the CSV's header (which it checks) and what the command
 /// printed.
 fn episode_rows(run: &str, args: &[&str]) -> (Vec<Vec<String>>, String) {
     let dir = fresh_dir(&format!("dexcube-cli-eval-stage-episodes-{run}"));
-    let csv = dir.join("episodes.csv");
     let policies = shipped_policy_flags();
     let args = [
-        &["eval-stage"][..],
         args,
-        &["--threads", "2", "--episodes-csv", csv.to_str().unwrap()],
+        &["--threads", "2"],
         &policies.each_ref().map(String::as_str),
     ]
     .concat();
-    let o = dexcube(&args, "");
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(&csv).unwrap();
+    let (text, printed) = eval_stage_csv(&dir.join("episodes.csv"), &args);
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
@@ -1274,7 +1284,7 @@ fn episode_rows(run: &str, args: &[&str]) -> (Vec<Vec<String>>, String) {
     let rows = lines
         .map(|line| line.split(',').map(String::from).collect())
         .collect();
-    (rows, stdout(&o))
+    (rows, printed)
 }
 
 /// `eval-stage --episodes-csv` writes one row per episode, in order, whose endings add up to
@@ -1425,24 +1435,25 @@ fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
     };
     // Each episode's row less its last column, whether it was handed over, and that column.
     let rows = |policy: &str| {
-        let csv = dir.join("episodes.csv");
         let args = [
-            &["eval-stage", "rot", "--episodes", "2", "--threads", "2"][..],
-            &["--seed", "2000000", "--episodes-csv", csv.to_str().unwrap()],
+            &[
+                "rot",
+                "--episodes",
+                "2",
+                "--threads",
+                "2",
+                "--seed",
+                "2000000",
+            ][..],
             &["--rot-policy", policy, "--layer-policy", layer],
         ]
         .concat();
-        let o = dexcube(&args, "");
-        assert!(o.status.success(), "{}", stderr(&o));
-        let text = std::fs::read_to_string(&csv).unwrap();
+        let (text, printed) = eval_stage_csv(&dir.join("episodes.csv"), &args);
         let split = |line: &str| {
             let (row, handed) = line.rsplit_once(',').unwrap();
             (row.to_string(), handed.to_string())
         };
-        (
-            text.lines().skip(1).map(split).collect::<Vec<_>>(),
-            stdout(&o),
-        )
+        (text.lines().skip(1).map(split).collect::<Vec<_>>(), printed)
     };
     let (alone, _) = rows(member);
     let (together, _) = rows(rot);
@@ -1523,23 +1534,19 @@ fn eval_stage_records_where_an_ensemble_hands_over() {
     );
     assert!(made.status.success(), "{}", stderr(&made));
     let run = |policy: &str, from: &[&str], csv: &str| {
-        let csv = dir.join(csv);
         let args = [
-            &["eval-stage", "rot", "--episodes", "3", "--threads", "2"][..],
+            &["rot", "--episodes", "3", "--threads", "2"][..],
             from,
             &["--rot-policy", policy, "--layer-policy", layer],
-            &["--episodes-csv", csv.to_str().unwrap()],
         ]
         .concat();
-        let o = dexcube(&args, "");
-        assert!(o.status.success(), "{}", stderr(&o));
-        let text = std::fs::read_to_string(&csv).unwrap();
+        let (text, printed) = eval_stage_csv(&dir.join(csv), &args);
         let endings: Vec<String> = text
             .lines()
             .skip(1)
             .map(|line| line.splitn(3, ',').nth(2).unwrap().to_string())
             .collect();
-        (endings, stdout(&o))
+        (endings, printed)
     };
     let fresh = ["--seed", "2000000"];
     let (handed, printed) = run(
@@ -1611,17 +1618,14 @@ fn a_policy_led_on_runs_on_the_goal_led_on() {
         stderr(&o)
     );
     let row = |policy: &str| {
-        let csv = dir.join("episodes.csv");
         let args = [
-            &["eval-stage", "layer", "--episodes", "1", "--threads", "1"][..],
+            &["layer", "--episodes", "1", "--threads", "1"][..],
             // An episode that turns the layer, so that it comes within the lead's reach.
-            &["--seed", "8000016", "--episodes-csv", csv.to_str().unwrap()],
+            &["--seed", "8000016"],
             &["--rot-policy", rot, "--layer-policy", policy],
         ]
         .concat();
-        let o = dexcube(&args, "");
-        assert!(o.status.success(), "{}", stderr(&o));
-        std::fs::read_to_string(&csv).unwrap()
+        eval_stage_csv(&dir.join("episodes.csv"), &args).0
     };
     assert_ne!(row(layer), row(led), "the same episode, acted otherwise");
     for (flags, says) in [

@@ -21,14 +21,14 @@ pub struct Handover {
     pub progress: f64,
 }
 
-/// What a handover keeps of one episode: the nearest the cube has come to its goal, how many
-/// steps it has stalled since, and whether the member has taken over.
+/// What a handover keeps of one episode: the nearest the cube has come to its goal and how
+/// many steps it has stalled since. The member has taken over once that reaches the patience;
+/// the count then stops.
 #[derive(Clone, Debug)]
 pub struct HandoverWatch {
     handover: Handover,
     nearest: f64,
     stalled: usize,
-    handed_over: bool,
 }
 
 impl HandoverWatch {
@@ -37,7 +37,6 @@ impl HandoverWatch {
             handover,
             nearest: f64::INFINITY,
             stalled: 0,
-            handed_over: false,
         }
     }
 
@@ -45,22 +44,18 @@ impl HandoverWatch {
     /// `met` when it meets its test, and says whether the member acts on it. Once handed
     /// over, the member acts to the end of the episode.
     pub fn member_acts(&mut self, angle: f64, met: bool) -> bool {
-        let Handover {
-            patience, progress, ..
-        } = self.handover;
-        let nearer = angle < self.nearest - progress;
-        if nearer {
-            self.nearest = angle;
-        }
-        if !self.handed_over {
+        if !self.handed_over() {
+            let nearer = angle < self.nearest - self.handover.progress;
+            if nearer {
+                self.nearest = angle;
+            }
             self.stalled = if met || nearer { 0 } else { self.stalled + 1 };
-            self.handed_over = self.stalled >= patience;
         }
-        self.handed_over
+        self.handed_over()
     }
 
     pub fn handed_over(&self) -> bool {
-        self.handed_over
+        self.stalled >= self.handover.patience
     }
 }
 

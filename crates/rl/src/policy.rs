@@ -120,7 +120,7 @@ fn restated(
 ) -> Result<(), CheckpointError> {
     let (weights, mut card, tensors) = read_stored(policy)?;
     change(&mut card).map_err(|message| CheckpointError::Refused {
-        path: weights.clone(),
+        path: weights,
         message,
     })?;
     card.metadata = derived_metadata(&card, how, (key, policy), command);
@@ -618,9 +618,12 @@ impl Acting<'_> {
             Some(lead) => test.led(&now, desired, lead),
             None => desired.to_vec(),
         };
+        // Once handed over, the member acts to the end: the test need not be read again.
         let handed = self.watch.as_mut().is_some_and(|watch| {
-            let met = test.is_success(&now, desired);
-            watch.member_acts(test.errors(&now, desired).1, met)
+            watch.handed_over() || {
+                let met = test.is_success(&now, desired);
+                watch.member_acts(test.errors(&now, desired).1, met)
+            }
         });
         match policy.card.handover {
             Some(handover) if handed => policy.member_action(handover.member, observation, &shown),
