@@ -335,6 +335,10 @@ pub struct HandoverArgs {
     /// to count as progress.
     #[arg(long, default_value_t = 0.05, value_name = "RAD", value_parser = handover_progress)]
     progress: f64,
+    /// The member that acts alone until the handover; without it the ensemble acts with its
+    /// members' mean action until then.
+    #[arg(long)]
+    first: Option<usize>,
     /// Where to write the result (PATH.safetensors and PATH.json).
     #[arg(long)]
     out: PathBuf,
@@ -346,22 +350,30 @@ fn handover_progress(text: &str) -> Result<f64, String> {
 
 pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
     let command = format!(
-        "dexcube handover {} --member {} --patience {} --progress {} --out {}",
+        "dexcube handover {} --member {} --patience {} --progress {}{} --out {}",
         args.policy.display(),
         args.member,
         args.patience,
         args.progress,
+        args.first
+            .map(|k| format!(" --first {k}"))
+            .unwrap_or_default(),
         args.out.display()
     );
     let handover = Handover {
         member: args.member,
         patience: args.patience,
         progress: args.progress,
+        first: args.first,
     };
     Policy::handing_over(&args.policy, handover, &args.out, &command)?;
+    let acting = match args.first {
+        Some(first) => format!(", member {first} acting alone until then"),
+        None => String::new(),
+    };
     println!(
-        "{} handing a stalled episode to member {} (after {} steps without {} rad of progress) \
-         into {}",
+        "{} handing a stalled episode to member {} (after {} steps without {} rad of \
+         progress{acting}) into {}",
         args.policy.display(),
         args.member,
         args.patience,

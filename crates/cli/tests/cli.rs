@@ -1410,29 +1410,33 @@ fn eval_stage_records_where_stage1_misses_came_closest() {
 
 /// `handover` writes an ensemble that `eval-stage` runs handing stalled episodes to a member:
 /// at once (a patience of 0) it runs each episode as that member alone, never (a patience
-/// longer than an episode) as the ensemble, and the CSV says which were handed over. A single
-/// policy and a member the ensemble lacks are refused, and so is distilling it.
+/// longer than an episode) as the ensemble, and the CSV says which were handed over. Told to let
+/// a member act first and never handing over, it runs as that member alone. A single policy
+/// and a member the ensemble lacks are refused, and so is distilling it.
 #[test]
 fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
     let dir = fresh_dir("dexcube-cli-handover");
     std::fs::create_dir_all(&dir).unwrap();
     let [rot, member, layer] = ["rot", "rot-td3-19", "layer"].map(|name| models().join(name));
     let [rot, member, layer] = [&rot, &member, &layer].map(|path| path.to_str().unwrap());
-    let handing = |patience: &str| {
-        let out = dir.join(format!("rot-hand-{patience}"));
+    // Handing over to `member` after `patience` steps, and `first` acting alone until then.
+    let handing_after = |first: &[&str], member: &str, patience: &str| {
+        let out = dir.join(format!("rot-hand-{}-{member}-{patience}", first.concat()));
         let args = [
-            &["handover", rot, "--member", "2", "--patience", patience][..],
+            &["handover", rot, "--member", member, "--patience", patience][..],
+            first,
             &["--out", out.to_str().unwrap()],
         ]
         .concat();
         let o = dexcube(&args, "");
         assert!(
-            o.status.success() && stdout(&o).contains("to member 2"),
+            o.status.success() && stdout(&o).contains(&format!("to member {member}")),
             "{}",
             stderr(&o)
         );
         out.to_str().unwrap().to_string()
     };
+    let handing = |patience: &str| handing_after(&[], "2", patience);
     // Each episode's row less its last column, whether it was handed over, and that column.
     let rows = |policy: &str| {
         let args = [
@@ -1478,6 +1482,11 @@ fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
         "{printed}"
     );
     assert_eq!(never, together);
+    let (first_alone, _) = rows(&handing_after(&["--first", "2"], "0", "1000"));
+    assert_eq!(
+        first_alone, alone,
+        "member 2 acting first, never handing over"
+    );
     let (teacher, out) = (handing("5"), dir.join("student"));
     let distil = [
         &["distil", "rot", "--rot-policy", &teacher][..],

@@ -6,19 +6,23 @@
 //! `results/TRAINING.md` found the states where `models/rot` stayed stuck more than half a
 //! radian from its pose are ones each member alone mostly leaves. A policy with a handover
 //! acts as the ensemble until the cube has stalled, then as the one member for the rest of
-//! the episode.
+//! the episode. It may instead act as another member alone until then: one policy falling
+//! back on another (session 51).
 
 use serde::{Deserialize, Serialize};
 
 /// Hands the episode to member `member` (0 is the first) once the cube has gone `patience`
 /// control steps in a row neither meeting its test nor coming `progress` radians nearer its
 /// goal than it has yet been. A patience of 0 hands over before the first step: the member
-/// alone.
+/// alone. Until then the ensemble acts with its members' mean action, or, where `first`
+/// names a member, with that member's alone: one policy falling back on another.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Handover {
     pub member: usize,
     pub patience: usize,
     pub progress: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first: Option<usize>,
 }
 
 /// What a handover keeps of one episode: the nearest the cube has come to its goal and how
@@ -68,6 +72,7 @@ mod tests {
             member: 1,
             patience,
             progress: 0.05,
+            first: None,
         })
     }
 

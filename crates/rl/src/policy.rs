@@ -435,8 +435,12 @@ impl Policy {
         out: &Path,
         command: &str,
     ) -> Result<(), CheckpointError> {
+        let acting = match handover.first {
+            Some(first) => format!("member {first} acting alone, "),
+            None => String::new(),
+        };
         let how = format!(
-            "handing over to member {} after {} steps without {} rad of progress",
+            "{acting}handing over to member {} after {} steps without {} rad of progress",
             handover.member, handover.patience, handover.progress
         );
         restated(policy, (out, command), ("handing_over", how), |card| {
@@ -453,10 +457,17 @@ impl Policy {
                         .into(),
                 );
             }
-            if handover.member >= members {
+            for member in std::iter::once(handover.member).chain(handover.first) {
+                if member >= members {
+                    return Err(format!(
+                        "it has {members} members (0 to {}), not a member {member}",
+                        members - 1,
+                    ));
+                }
+            }
+            if handover.first == Some(handover.member) {
                 return Err(format!(
-                    "it has {members} members (0 to {}), not a member {}",
-                    members - 1,
+                    "member {} would hand over to itself: name another member to act first",
                     handover.member
                 ));
             }
@@ -627,6 +638,9 @@ impl Acting<'_> {
         });
         match policy.card.handover {
             Some(handover) if handed => policy.member_action(handover.member, observation, &shown),
+            Some(Handover {
+                first: Some(first), ..
+            }) => policy.member_action(first, observation, &shown),
             _ => policy.act(observation, &shown),
         }
     }

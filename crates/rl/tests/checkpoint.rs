@@ -953,8 +953,9 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
 }
 
 /// An ensemble that hands over acts as the ensemble until its episode has stalled for its
-/// patience, then as its member to the end; a fresh episode begins as the ensemble again. A
-/// single policy, a member it lacks and a second handover are refused.
+/// patience, then as its member to the end; a fresh episode begins as the ensemble again. One
+/// that names a member to act first acts as that member alone until then. A single policy, a
+/// member it lacks, a member handing to itself and a second handover are refused.
 #[test]
 fn an_ensemble_hands_a_stalled_episode_to_its_member() {
     let dir = fresh_dir("dexcube-rl-handover");
@@ -966,17 +967,20 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
     ];
     let ensemble = dir.join("ensemble");
     Policy::ensemble(&members, &ensemble, "dexcube ensemble ...").unwrap();
-    let handing = |member: usize, patience: usize| {
-        let out = dir.join(format!("hand{member}-{patience}"));
+    let handing_after = |first: Option<usize>, member: usize, patience: usize| {
+        let out = dir.join(format!("hand{first:?}-{member}-{patience}"));
         let handover = Handover {
             member,
             patience,
             progress: 0.05,
+            first,
         };
         Policy::handing_over(&ensemble, handover, &out, "dexcube handover ...").map(|()| out)
     };
-    let (together, second) = (
+    let handing = |member: usize, patience: usize| handing_after(None, member, patience);
+    let (together, first, second) = (
         Policy::load(&ensemble, &device).unwrap(),
+        Policy::load(&members[0], &device).unwrap(),
         Policy::load(&members[1], &device).unwrap(),
     );
     let hands = Policy::load(&handing(1, 2).unwrap(), &device).unwrap();
@@ -993,19 +997,26 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
         together.act(&obs.observation, desired),
         second.act(&obs.observation, desired),
     );
+    let as_first = first.act(&obs.observation, desired);
     assert_ne!(as_ensemble, as_member, "the members differ");
-    for _episode in 0..2 {
-        let mut acting = hands.episode();
-        // The cube never moves: the first step is progress, the next two stall.
-        for step in 1..=5 {
-            let action = acting.act_toward(&obs.observation, desired, || achieved.clone(), &test);
-            let (expected, handed) = if step < 3 {
-                (&as_ensemble, false)
-            } else {
-                (&as_member, true)
-            };
-            assert_eq!(&action, expected, "step {step}");
-            assert_eq!(acting.handed_over(), handed, "step {step}");
+    assert_ne!(as_ensemble, as_first, "the mean is neither member");
+    // Member 0 acting alone until it hands over, in place of the mean.
+    let falls_back = Policy::load(&handing_after(Some(0), 1, 2).unwrap(), &device).unwrap();
+    for (policy, before) in [(&hands, &as_ensemble), (&falls_back, &as_first)] {
+        for _episode in 0..2 {
+            let mut acting = policy.episode();
+            // The cube never moves: the first step is progress, the next two stall.
+            for step in 1..=5 {
+                let action =
+                    acting.act_toward(&obs.observation, desired, || achieved.clone(), &test);
+                let (expected, handed) = if step < 3 {
+                    (before, false)
+                } else {
+                    (&as_member, true)
+                };
+                assert_eq!(&action, expected, "step {step}");
+                assert_eq!(acting.handed_over(), handed, "step {step}");
+            }
         }
     }
     let at_once = Policy::load(&handing(1, 0).unwrap(), &device).unwrap();
@@ -1018,13 +1029,16 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
         let result = Policy::handing_over(from, handover, &dir.join("x"), "");
         result.err().unwrap().to_string()
     };
-    assert!(refusal(&dir.join("hand1-2")).contains("hands over already"));
+    assert!(refusal(&dir.join("handNone-1-2")).contains("hands over already"));
     assert!(refusal(&members[1]).contains("single policy, with no member"));
-    let lacking = handing(2, 5).err().unwrap().to_string();
-    assert!(
-        lacking.contains("2 members (0 to 1), not a member 2"),
-        "{lacking}"
-    );
+    for (first, member, says) in [
+        (None, 2, "2 members (0 to 1), not a member 2"),
+        (Some(2), 1, "2 members (0 to 1), not a member 2"),
+        (Some(1), 1, "member 1 would hand over to itself"),
+    ] {
+        let refused = handing_after(first, member, 5).err().unwrap().to_string();
+        assert!(refused.contains(says), "{refused}");
+    }
 }
 
 /// The outputs of `net` on a fixed batch of `inputs`-long rows.
