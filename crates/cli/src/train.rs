@@ -320,8 +320,8 @@ pub fn goal_lead(args: GoalLeadArgs) -> anyhow::Result<ExitCode> {
 
 #[derive(Args)]
 pub struct HandoverArgs {
-    /// The ensemble (led on or not), as the path of its .safetensors and .json less the
-    /// extension.
+    /// The ensemble (led on or not), or with --let-go a single policy, as the path of its
+    /// .safetensors and .json less the extension.
     policy: PathBuf,
     /// The member handed over to, counted from 0 in the order the ensemble was made
     /// (`models/rot`: 0 the seen run's `epoch-0047`, 1 `rot-dropw20`, 2 `rot-td3-19`).
@@ -339,6 +339,10 @@ pub struct HandoverArgs {
     /// members' mean action until then.
     #[arg(long)]
     first: Option<usize>,
+    /// Control steps the hand takes the neutral action for once handed over (the flat hand
+    /// every episode settles on), before the member acts: letting go and trying again.
+    #[arg(long, value_name = "STEPS")]
+    let_go: Option<usize>,
     /// Where to write the result (PATH.safetensors and PATH.json).
     #[arg(long)]
     out: PathBuf,
@@ -350,13 +354,16 @@ fn handover_progress(text: &str) -> Result<f64, String> {
 
 pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
     let command = format!(
-        "dexcube handover {} --member {} --patience {} --progress {}{} --out {}",
+        "dexcube handover {} --member {} --patience {} --progress {}{}{} --out {}",
         args.policy.display(),
         args.member,
         args.patience,
         args.progress,
         args.first
             .map(|k| format!(" --first {k}"))
+            .unwrap_or_default(),
+        args.let_go
+            .map(|n| format!(" --let-go {n}"))
             .unwrap_or_default(),
         args.out.display()
     );
@@ -365,10 +372,14 @@ pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
         patience: args.patience,
         progress: args.progress,
         first: args.first,
+        let_go: args.let_go,
     };
     Policy::handing_over(&args.policy, handover, &args.out, &command)?;
     let acting = match args.first {
         Some(first) => format!(", member {first} acting alone until then"),
+        None => String::new(),
+    } + &match args.let_go {
+        Some(steps) => format!(", letting go for {steps} steps first"),
         None => String::new(),
     };
     println!(

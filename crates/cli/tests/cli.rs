@@ -1245,6 +1245,38 @@ fn eval_stage_writes_a_video_of_its_first_episode() {
     );
 }
 
+/// Runs `eval-stage` on two episodes of `stage` from `seed` with the `[rot, layer]` policies,
+/// in `dir`, and returns each episode's row less its last column, whether it was handed over,
+/// and that column, with what the command printed.
+fn two_episodes(
+    dir: &std::path::Path,
+    (stage, seed): (&str, &str),
+    [rot, layer]: [&str; 2],
+) -> (Vec<(String, String)>, String) {
+    let args = [stage, "--episodes", "2", "--threads", "2", "--seed", seed];
+    let policies = ["--rot-policy", rot, "--layer-policy", layer];
+    let (text, printed) =
+        eval_stage_csv(&dir.join("episodes.csv"), &[&args[..], &policies].concat());
+    let split = |line: &str| {
+        let (row, handed) = line.rsplit_once(',').unwrap();
+        (row.to_string(), handed.to_string())
+    };
+    (text.lines().skip(1).map(split).collect(), printed)
+}
+
+/// Runs `handover` with `args` into `out`, checks that it succeeded saying `says`, and returns
+/// `out` as the policy path to pass on.
+fn handover_into(args: &[&str], out: &std::path::Path, says: &str) -> String {
+    let out = out.to_str().unwrap();
+    let o = dexcube(&[&["handover"][..], args, &["--out", out]].concat(), "");
+    assert!(
+        o.status.success() && stdout(&o).contains(says),
+        "{}",
+        stderr(&o)
+    );
+    out.to_string()
+}
+
 /// Runs `eval-stage` with `args` and `--episodes-csv csv`, checks that it succeeded, and
 /// returns the CSV's text and what the command printed.
 fn eval_stage_csv(csv: &std::path::Path, args: &[&str]) -> (String, String) {
@@ -1423,42 +1455,14 @@ fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
     let handing_after = |first: &[&str], member: &str, patience: &str| {
         let out = dir.join(format!("rot-hand-{}-{member}-{patience}", first.concat()));
         let args = [
-            &["handover", rot, "--member", member, "--patience", patience][..],
+            &[rot, "--member", member, "--patience", patience][..],
             first,
-            &["--out", out.to_str().unwrap()],
         ]
         .concat();
-        let o = dexcube(&args, "");
-        assert!(
-            o.status.success() && stdout(&o).contains(&format!("to member {member}")),
-            "{}",
-            stderr(&o)
-        );
-        out.to_str().unwrap().to_string()
+        handover_into(&args, &out, &format!("to member {member}"))
     };
     let handing = |patience: &str| handing_after(&[], "2", patience);
-    // Each episode's row less its last column, whether it was handed over, and that column.
-    let rows = |policy: &str| {
-        let args = [
-            &[
-                "rot",
-                "--episodes",
-                "2",
-                "--threads",
-                "2",
-                "--seed",
-                "2000000",
-            ][..],
-            &["--rot-policy", policy, "--layer-policy", layer],
-        ]
-        .concat();
-        let (text, printed) = eval_stage_csv(&dir.join("episodes.csv"), &args);
-        let split = |line: &str| {
-            let (row, handed) = line.rsplit_once(',').unwrap();
-            (row.to_string(), handed.to_string())
-        };
-        (text.lines().skip(1).map(split).collect::<Vec<_>>(), printed)
-    };
+    let rows = |policy: &str| two_episodes(&dir, ("rot", "2000000"), [policy, layer]);
     let (alone, _) = rows(member);
     let (together, _) = rows(rot);
     assert_ne!(
@@ -1513,6 +1517,39 @@ fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
         ]
         .concat();
         assert_clean_failure(&dexcube(&args, ""), 2, says);
+    }
+}
+
+/// `handover --let-go N` on a single Stage 2 policy: never handed over it runs every episode as
+/// the policy alone; handed over at once and letting go for the whole episode, the hand only
+/// ever takes the neutral action, so no layer turns.
+#[test]
+fn a_policy_letting_go_takes_the_neutral_action_then_tries_again() {
+    let dir = fresh_dir("dexcube-cli-let-go");
+    std::fs::create_dir_all(&dir).unwrap();
+    let [rot, layer] = ["rot", "layer"].map(|name| models().join(name));
+    let [rot, layer] = [&rot, &layer].map(|path| path.to_str().unwrap());
+    let letting_go = |patience: &str, steps: &str| {
+        let out = dir.join(format!("layer-let-go-{patience}-{steps}"));
+        let args = [
+            layer,
+            "--member",
+            "0",
+            "--patience",
+            patience,
+            "--let-go",
+            steps,
+        ];
+        handover_into(&args, &out, &format!("letting go for {steps} steps"))
+    };
+    let rows = |policy: &str| {
+        let (rows, _) = two_episodes(&dir, ("layer", "13000000"), [rot, policy]);
+        rows.into_iter().map(|(row, _)| row).collect::<Vec<_>>()
+    };
+    assert_eq!(rows(&letting_go("1000", "5")), rows(layer));
+    for row in rows(&letting_go("0", "100")) {
+        let ending = row.split(',').nth(2).unwrap();
+        assert_eq!(ending, "never_turned", "{row}");
     }
 }
 

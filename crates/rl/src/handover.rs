@@ -7,7 +7,8 @@
 //! radian from its pose are ones each member alone mostly leaves. A policy with a handover
 //! acts as the ensemble until the cube has stalled, then as the one member for the rest of
 //! the episode. It may instead act as another member alone until then: one policy falling
-//! back on another (session 51).
+//! back on another; and it may let go for some steps before the member acts, which lets a
+//! single policy try again itself (session 51).
 
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +24,10 @@ pub struct Handover {
     pub progress: f64,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub first: Option<usize>,
+    /// Control steps the hand takes the neutral action for once handed over (the flat hand
+    /// every episode settles on), before the member acts: letting go and trying again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub let_go: Option<usize>,
 }
 
 /// What a handover keeps of one episode: the nearest the cube has come to its goal and how
@@ -33,6 +38,7 @@ pub struct HandoverWatch {
     handover: Handover,
     nearest: f64,
     stalled: usize,
+    since_handover: usize,
 }
 
 impl HandoverWatch {
@@ -41,6 +47,7 @@ impl HandoverWatch {
             handover,
             nearest: f64::INFINITY,
             stalled: 0,
+            since_handover: 0,
         }
     }
 
@@ -61,6 +68,13 @@ impl HandoverWatch {
     pub fn handed_over(&self) -> bool {
         self.stalled >= self.handover.patience
     }
+
+    /// Counts a step acted on after the handover and says whether the hand still lets go
+    /// ([`Handover::let_go`]) rather than the member acting.
+    pub fn letting_go(&mut self) -> bool {
+        self.since_handover += 1;
+        self.since_handover <= self.handover.let_go.unwrap_or(0)
+    }
 }
 
 #[cfg(test)]
@@ -73,6 +87,7 @@ mod tests {
             patience,
             progress: 0.05,
             first: None,
+            let_go: None,
         })
     }
 

@@ -427,8 +427,9 @@ impl Policy {
     }
 
     /// Writes at `out` the ensemble at `policy` (led on or not) handing a stalled episode to
-    /// one member as `handover` says ([`Handover`]); its weights are unchanged. The card records
-    /// the ensemble and `command`, the command that made it.
+    /// one member as `handover` says ([`Handover`]); its weights are unchanged. A single policy
+    /// may hand the episode to itself if it lets go first. The card records the policy and
+    /// `command`, the command that made it.
     pub fn handing_over(
         policy: &Path,
         handover: Handover,
@@ -439,8 +440,13 @@ impl Policy {
             Some(first) => format!("member {first} acting alone, "),
             None => String::new(),
         };
+        let letting_go = match handover.let_go {
+            Some(steps) => format!(", letting go for {steps} steps first"),
+            None => String::new(),
+        };
         let how = format!(
-            "{acting}handing over to member {} after {} steps without {} rad of progress",
+            "{acting}handing over to member {} after {} steps without {} rad of \
+             progress{letting_go}",
             handover.member, handover.patience, handover.progress
         );
         restated(policy, (out, command), ("handing_over", how), |card| {
@@ -449,11 +455,14 @@ impl Policy {
                     "it hands over already: start from the ensemble it was made from".into(),
                 );
             }
+            // Letting go, a policy may hand the episode to itself: it tries again.
+            let letting_go = handover.let_go.is_some();
             let members = 1 + card.partners.len();
-            if members == 1 {
+            if members == 1 && !letting_go {
                 return Err(
                     "it is a single policy, with no member to hand over to: make an \
-                            ensemble first (`dexcube ensemble`)"
+                     ensemble first (`dexcube ensemble`), or let it go and try again itself \
+                     (`--let-go`)"
                         .into(),
                 );
             }
@@ -465,9 +474,10 @@ impl Policy {
                     ));
                 }
             }
-            if handover.first == Some(handover.member) {
+            if handover.first == Some(handover.member) && !letting_go {
                 return Err(format!(
-                    "member {} would hand over to itself: name another member to act first",
+                    "member {} would hand over to itself: name another member to act first, \
+                     or let it go first (`--let-go`)",
                     handover.member
                 ));
             }
@@ -636,6 +646,9 @@ impl Acting<'_> {
                 watch.member_acts(test.errors(&now, desired).1, met)
             }
         });
+        if handed && self.watch.as_mut().is_some_and(HandoverWatch::letting_go) {
+            return vec![0.0; policy.card.dims.action];
+        }
         match policy.card.handover {
             Some(handover) if handed => policy.member_action(handover.member, observation, &shown),
             Some(Handover {

@@ -954,8 +954,10 @@ fn a_policy_led_on_acts_toward_the_goal_led_on_and_is_not_combined() {
 
 /// An ensemble that hands over acts as the ensemble until its episode has stalled for its
 /// patience, then as its member to the end; a fresh episode begins as the ensemble again. One
-/// that names a member to act first acts as that member alone until then. A single policy, a
-/// member it lacks, a member handing to itself and a second handover are refused.
+/// that names a member to act first acts as that member alone until then; one that lets go
+/// takes the neutral action for as many steps before the member acts, and so may a single
+/// policy. A single policy not letting go, a member it lacks, a member handing to itself and a
+/// second handover are refused.
 #[test]
 fn an_ensemble_hands_a_stalled_episode_to_its_member() {
     let dir = fresh_dir("dexcube-rl-handover");
@@ -974,6 +976,7 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
             patience,
             progress: 0.05,
             first,
+            let_go: None,
         };
         Policy::handing_over(&ensemble, handover, &out, "dexcube handover ...").map(|()| out)
     };
@@ -1017,6 +1020,40 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
                 assert_eq!(&action, expected, "step {step}");
                 assert_eq!(acting.handed_over(), handed, "step {step}");
             }
+        }
+    }
+    // Letting go for two steps once handed over: the neutral action, then the member; a
+    // single policy may so hand the episode to itself.
+    let letting_go = |from: &std::path::Path, member: usize, name: &str| {
+        let handover = Handover {
+            member,
+            patience: 2,
+            progress: 0.05,
+            first: None,
+            let_go: Some(2),
+        };
+        let out = dir.join(name);
+        Policy::handing_over(from, handover, &out, "dexcube handover ...").unwrap();
+        Policy::load(&out, &device).unwrap()
+    };
+    let neutral = vec![0.0; as_member.len()];
+    for (policy, before, after) in [
+        (letting_go(&ensemble, 1, "let-go"), &as_ensemble, &as_member),
+        (
+            letting_go(&members[1], 0, "let-go-alone"),
+            &as_member,
+            &as_member,
+        ),
+    ] {
+        let mut acting = policy.episode();
+        for step in 1..=6 {
+            let action = acting.act_toward(&obs.observation, desired, || achieved.clone(), &test);
+            let expected = match step {
+                1 | 2 => before,
+                3 | 4 => &neutral,
+                _ => after,
+            };
+            assert_eq!(&action, expected, "step {step}");
         }
     }
     let at_once = Policy::load(&handing(1, 0).unwrap(), &device).unwrap();
