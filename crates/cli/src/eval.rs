@@ -1275,7 +1275,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             failures_again.into_inner()
         );
     }
-    let save = |flag: &str, path: &Path, starts: &[RecordedStart]| {
+    // Writes what the episodes recorded, in episode order, and returns it.
+    let save = |flag: &str, path: &Path, recorded: Mutex<Vec<(usize, RecordedStart)>>| {
+        let starts = in_episode_order(recorded);
         let origin = StartsOrigin {
             stage: args.stage.name().to_string(),
             failure,
@@ -1286,11 +1288,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 path.display()
             ),
         };
-        save_starts(path, starts, &origin)
+        save_starts(path, &starts, &origin).map(|()| starts)
     };
     if let Some(path) = &args.record_starts {
-        let starts = in_episode_order(recorded);
-        save("--record-starts", path, &starts)?;
+        let starts = save("--record-starts", path, recorded)?;
         let failed = starts.iter().filter(|s| s.failed).count();
         println!(
             "  recorded the {} starts (from {failed} of which this policy {}) in {}",
@@ -1300,8 +1301,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if let Some(path) = &args.record_closest {
-        let closest = in_episode_order(recorded_closest);
-        save("--record-closest", path, &closest)?;
+        let closest = save("--record-closest", path, recorded_closest)?;
         println!(
             "  recorded where the {} misses that kept the cube came closest to their pose in {}",
             closest.len(),
@@ -1309,8 +1309,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if let Some(path) = &args.record_handovers {
-        let handovers = in_episode_order(recorded_handovers);
-        save("--record-handovers", path, &handovers)?;
+        let handovers = save("--record-handovers", path, recorded_handovers)?;
         let failed = handovers.iter().filter(|s| s.failed).count();
         println!(
             "  recorded where the {} episodes handed over ({failed} of them failed) were handed to the member in {}",

@@ -375,20 +375,9 @@ pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
         let_go: args.let_go,
     };
     Policy::handing_over(&args.policy, handover, &args.out, &command)?;
-    let acting = match args.first {
-        Some(first) => format!(", member {first} acting alone until then"),
-        None => String::new(),
-    } + &match args.let_go {
-        Some(steps) => format!(", letting go for {steps} steps first"),
-        None => String::new(),
-    };
     println!(
-        "{} handing a stalled episode to member {} (after {} steps without {} rad of \
-         progress{acting}) into {}",
+        "{} {handover} into {}",
         args.policy.display(),
-        args.member,
-        args.patience,
-        args.progress,
         args.out.display()
     );
     Ok(ExitCode::SUCCESS)

@@ -1564,21 +1564,9 @@ fn eval_stage_records_where_an_ensemble_hands_over() {
     let [rot, member, layer] = ["rot", "rot-td3-19", "layer"].map(|name| models().join(name));
     let [rot, member, layer] = [&rot, &member, &layer].map(|path| path.to_str().unwrap());
     let (at_once, file) = (dir.join("rot-hand-0"), dir.join("handovers.safetensors"));
-    let [at_once, file] = [&at_once, &file].map(|path| path.to_str().unwrap());
-    let made = dexcube(
-        &[
-            "handover",
-            rot,
-            "--member",
-            "2",
-            "--patience",
-            "0",
-            "--out",
-            at_once,
-        ],
-        "",
-    );
-    assert!(made.status.success(), "{}", stderr(&made));
+    let args = [rot, "--member", "2", "--patience", "0"];
+    let at_once = handover_into(&args, &at_once, "to member 2");
+    let (at_once, file) = (at_once.as_str(), file.to_str().unwrap());
     let run = |policy: &str, from: &[&str], csv: &str| {
         let args = [
             &["rot", "--episodes", "3", "--threads", "2"][..],

@@ -30,6 +30,35 @@ pub struct Handover {
     pub let_go: Option<usize>,
 }
 
+/// What the handover does, in words, for a policy's card and the command that makes it.
+impl std::fmt::Display for Handover {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "handing over to member {} after {} steps without {} rad of progress",
+            self.member, self.patience, self.progress
+        )?;
+        if let Some(first) = self.first {
+            write!(f, ", member {first} acting alone until then")?;
+        }
+        if let Some(steps) = self.let_go {
+            write!(f, ", letting go for {steps} steps first")?;
+        }
+        Ok(())
+    }
+}
+
+/// Who acts on a step of an episode with a handover ([`HandoverWatch::turn`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Turn {
+    /// Not handed over yet: the ensemble, or the member named to act first.
+    Before,
+    /// Handed over, and the hand still letting go: the neutral action.
+    LettingGo,
+    /// Handed over: the member.
+    Member,
+}
+
 /// What a handover keeps of one episode: the nearest the cube has come to its goal and how
 /// many steps it has stalled since. The member has taken over once that reaches the patience;
 /// the count then stops.
@@ -51,35 +80,50 @@ impl HandoverWatch {
         }
     }
 
-    /// Reads the step about to be acted on, the cube `angle` radians from its goal and
-    /// `met` when it meets its test, and says whether the member acts on it. Once handed
-    /// over, the member acts to the end of the episode.
-    pub fn member_acts(&mut self, angle: f64, met: bool) -> bool {
+    /// Says who acts on the step about to be acted on. Until the handover it reads the step
+    /// through `read`: the cube's angle from its goal, and whether it meets its test. Once
+    /// handed over, the member acts to the end of the episode (after letting go, where the
+    /// handover says so), and the step need not be read.
+    pub fn turn(&mut self, read: impl FnOnce() -> (f64, bool)) -> Turn {
         if !self.handed_over() {
+            let (angle, met) = read();
             let nearer = angle < self.nearest - self.handover.progress;
             if nearer {
                 self.nearest = angle;
             }
             self.stalled = if met || nearer { 0 } else { self.stalled + 1 };
+            if !self.handed_over() {
+                return Turn::Before;
+            }
         }
-        self.handed_over()
+        self.since_handover += 1;
+        if self.since_handover <= self.handover.let_go.unwrap_or(0) {
+            Turn::LettingGo
+        } else {
+            Turn::Member
+        }
     }
 
     pub fn handed_over(&self) -> bool {
         self.stalled >= self.handover.patience
-    }
-
-    /// Counts a step acted on after the handover and says whether the hand still lets go
-    /// ([`Handover::let_go`]) rather than the member acting.
-    pub fn letting_go(&mut self) -> bool {
-        self.since_handover += 1;
-        self.since_handover <= self.handover.let_go.unwrap_or(0)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Whether the member acts on a step with the cube `angle` from its goal, `met` when it
+    /// meets its test.
+    trait MemberActs {
+        fn member_acts(&mut self, angle: f64, met: bool) -> bool;
+    }
+
+    impl MemberActs for HandoverWatch {
+        fn member_acts(&mut self, angle: f64, met: bool) -> bool {
+            self.turn(|| (angle, met)) == Turn::Member
+        }
+    }
 
     fn watch(patience: usize) -> HandoverWatch {
         HandoverWatch::new(Handover {

@@ -21,7 +21,7 @@ use crate::agent::{Agent, Dims, network_inputs};
 use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
 use crate::guide::{self, CriticGuide, GuideCard};
-use crate::handover::{Handover, HandoverWatch};
+use crate::handover::{Handover, HandoverWatch, Turn};
 use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
 use crate::params::{self, NamedTensor};
@@ -436,54 +436,46 @@ impl Policy {
         out: &Path,
         command: &str,
     ) -> Result<(), CheckpointError> {
-        let acting = match handover.first {
-            Some(first) => format!("member {first} acting alone, "),
-            None => String::new(),
-        };
-        let letting_go = match handover.let_go {
-            Some(steps) => format!(", letting go for {steps} steps first"),
-            None => String::new(),
-        };
-        let how = format!(
-            "{acting}handing over to member {} after {} steps without {} rad of \
-             progress{letting_go}",
-            handover.member, handover.patience, handover.progress
-        );
-        restated(policy, (out, command), ("handing_over", how), |card| {
-            if card.handover.is_some() {
-                return Err(
-                    "it hands over already: start from the ensemble it was made from".into(),
-                );
-            }
-            // Letting go, a policy may hand the episode to itself: it tries again.
-            let letting_go = handover.let_go.is_some();
-            let members = 1 + card.partners.len();
-            if members == 1 && !letting_go {
-                return Err(
-                    "it is a single policy, with no member to hand over to: make an \
+        restated(
+            policy,
+            (out, command),
+            ("handing_over", handover.to_string()),
+            |card| {
+                if card.handover.is_some() {
+                    return Err(
+                        "it hands over already: start from the ensemble it was made from".into(),
+                    );
+                }
+                // Letting go, a policy may hand the episode to itself: it tries again.
+                let letting_go = handover.let_go.is_some();
+                let members = 1 + card.partners.len();
+                if members == 1 && !letting_go {
+                    return Err(
+                        "it is a single policy, with no member to hand over to: make an \
                      ensemble first (`dexcube ensemble`), or let it go and try again itself \
                      (`--let-go`)"
-                        .into(),
-                );
-            }
-            for member in std::iter::once(handover.member).chain(handover.first) {
-                if member >= members {
+                            .into(),
+                    );
+                }
+                for member in std::iter::once(handover.member).chain(handover.first) {
+                    if member >= members {
+                        return Err(format!(
+                            "it has {members} members (0 to {}), not a member {member}",
+                            members - 1,
+                        ));
+                    }
+                }
+                if handover.first == Some(handover.member) && !letting_go {
                     return Err(format!(
-                        "it has {members} members (0 to {}), not a member {member}",
-                        members - 1,
+                        "member {} would hand over to itself: name another member to act first, \
+                     or let it go first (`--let-go`)",
+                        handover.member
                     ));
                 }
-            }
-            if handover.first == Some(handover.member) && !letting_go {
-                return Err(format!(
-                    "member {} would hand over to itself: name another member to act first, \
-                     or let it go first (`--let-go`)",
-                    handover.member
-                ));
-            }
-            card.handover = Some(handover);
-            Ok(())
-        })
+                card.handover = Some(handover);
+                Ok(())
+            },
+        )
     }
 
     /// Loads the policy at `prefix` onto `device`.
@@ -639,21 +631,20 @@ impl Acting<'_> {
             Some(lead) => test.led(&now, desired, lead),
             None => desired.to_vec(),
         };
-        // Once handed over, the member acts to the end: the test need not be read again.
-        let handed = self.watch.as_mut().is_some_and(|watch| {
-            watch.handed_over() || {
-                let met = test.is_success(&now, desired);
-                watch.member_acts(test.errors(&now, desired).1, met)
-            }
+        let turn = self.watch.as_mut().map_or(Turn::Before, |watch| {
+            watch.turn(|| (test.errors(&now, desired).1, test.is_success(&now, desired)))
         });
-        if handed && self.watch.as_mut().is_some_and(HandoverWatch::letting_go) {
-            return vec![0.0; policy.card.dims.action];
-        }
-        match policy.card.handover {
-            Some(handover) if handed => policy.member_action(handover.member, observation, &shown),
-            Some(Handover {
-                first: Some(first), ..
-            }) => policy.member_action(first, observation, &shown),
+        match (turn, policy.card.handover) {
+            (Turn::LettingGo, _) => vec![0.0; policy.card.dims.action],
+            (Turn::Member, Some(handover)) => {
+                policy.member_action(handover.member, observation, &shown)
+            }
+            (
+                Turn::Before,
+                Some(Handover {
+                    first: Some(first), ..
+                }),
+            ) => policy.member_action(first, observation, &shown),
             _ => policy.act(observation, &shown),
         }
     }
