@@ -436,46 +436,41 @@ impl Policy {
         out: &Path,
         command: &str,
     ) -> Result<(), CheckpointError> {
-        restated(
-            policy,
-            (out, command),
-            ("handing_over", handover.to_string()),
-            |card| {
-                if card.handover.is_some() {
-                    return Err(
-                        "it hands over already: start from the ensemble it was made from".into(),
-                    );
-                }
-                // Letting go, a policy may hand the episode to itself: it tries again.
-                let letting_go = handover.let_go.is_some();
-                let members = 1 + card.partners.len();
-                if members == 1 && !letting_go {
-                    return Err(
-                        "it is a single policy, with no member to hand over to: make an \
-                     ensemble first (`dexcube ensemble`), or let it go and try again itself \
-                     (`--let-go`)"
-                            .into(),
-                    );
-                }
-                for member in std::iter::once(handover.member).chain(handover.first) {
-                    if member >= members {
-                        return Err(format!(
-                            "it has {members} members (0 to {}), not a member {member}",
-                            members - 1,
-                        ));
-                    }
-                }
-                if handover.first == Some(handover.member) && !letting_go {
+        let how = handover.to_string();
+        restated(policy, (out, command), ("handing_over", how), |card| {
+            if card.handover.is_some() {
+                return Err(
+                    "it hands over already: start from the ensemble it was made from".into(),
+                );
+            }
+            // Letting go, a policy may hand the episode to itself: it tries again.
+            let letting_go = handover.let_go.is_some();
+            let members = 1 + card.partners.len();
+            if members == 1 && !letting_go {
+                return Err(
+                    "it is a single policy, with no member to hand over to: make an ensemble \
+                     first (`dexcube ensemble`), or let it go and try again itself (`--let-go`)"
+                        .into(),
+                );
+            }
+            for member in std::iter::once(handover.member).chain(handover.first) {
+                if member >= members {
                     return Err(format!(
-                        "member {} would hand over to itself: name another member to act first, \
-                     or let it go first (`--let-go`)",
-                        handover.member
+                        "it has {members} members (0 to {}), not a member {member}",
+                        members - 1,
                     ));
                 }
-                card.handover = Some(handover);
-                Ok(())
-            },
-        )
+            }
+            if handover.first == Some(handover.member) && !letting_go {
+                return Err(format!(
+                    "member {} would hand over to itself: name another member to act first, \
+                     or let it go first (`--let-go`)",
+                    handover.member
+                ));
+            }
+            card.handover = Some(handover);
+            Ok(())
+        })
     }
 
     /// Loads the policy at `prefix` onto `device`.
