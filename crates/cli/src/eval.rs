@@ -898,6 +898,8 @@ struct EpisodeTrace {
     handover: Option<RecordedStart>,
     /// An ensemble with a handover handed the episode to its member.
     handed_over: bool,
+    /// A policy with a start gesture made it before it first acted.
+    gestured: bool,
 }
 
 /// What an episode keeps of its physics, for `--record-starts`, `--record-closest` and
@@ -976,6 +978,7 @@ fn episode(
                 closest,
                 handover,
                 handed_over: acting.handed_over(),
+                gestured: acting.gestured(),
             };
         }
         obs = t.observation;
@@ -995,6 +998,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
     // Episodes an ensemble handed to its member, and of them successes.
     let (handovers, successes_handed_over) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    // Episodes that began with a start gesture, and of them successes.
+    let (gestures, successes_gestured) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
     let (thresholds, control_rate) = (setup.thresholds, setup.control_rate);
     if args.record && args.physics_spread > 0.0 {
@@ -1032,7 +1037,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let (prefix, object, scene) = (setup.prefix.clone(), setup.object, setup.scene.clone());
-    let handover = PolicyCard::read(&prefix)?.handover;
+    let card = PolicyCard::read(&prefix)?;
+    let (handover, start_gesture) = (card.handover, card.start_gesture);
     if args.record_handovers.is_some() && handover.is_none() {
         bail!(
             "--record-handovers keeps where an ensemble hands an episode to its member, and {} \
@@ -1137,10 +1143,15 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     successes_with_layer_turns.fetch_add(1, Ordering::Relaxed);
                 }
             }
-            if trace.handed_over {
-                handovers.fetch_add(1, Ordering::Relaxed);
-                if ending == Ending::Success {
-                    successes_handed_over.fetch_add(1, Ordering::Relaxed);
+            for (happened, count, successes) in [
+                (trace.handed_over, &handovers, &successes_handed_over),
+                (trace.gestured, &gestures, &successes_gestured),
+            ] {
+                if happened {
+                    count.fetch_add(1, Ordering::Relaxed);
+                    if ending == Ending::Success {
+                        successes.fetch_add(1, Ordering::Relaxed);
+                    }
                 }
             }
             if args.episodes_csv.is_some() {
@@ -1260,6 +1271,13 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             handover.member,
             handovers.into_inner(),
             successes_handed_over.into_inner()
+        );
+    }
+    if start_gesture.is_some() {
+        println!(
+            "  began with the start gesture in {} episodes ({} of them successes)",
+            gestures.into_inner(),
+            successes_gestured.into_inner()
         );
     }
     for (count, steps) in held.iter().zip(HOLDS) {

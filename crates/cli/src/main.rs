@@ -58,6 +58,12 @@ enum Command {
     /// their mean can turn it neither). Writes a policy that loads and runs as any other; its
     /// weights are unchanged.
     Handover(train::HandoverArgs),
+    /// Lets a policy begin with a gesture where the cube starts towards the fingertips: for
+    /// its first few steps, some actuators take a fixed action and the rest the neutral one,
+    /// then the policy acts (Stage 2 mends most of its failures on that side of the palm with
+    /// the knuckles straightened first). Writes a policy that loads and runs as any other; its
+    /// weights are unchanged.
+    StartGesture(train::StartGestureArgs),
     /// Teaches one actor to act as a stage policy does (an ensemble, typically) by DAgger:
     /// the teacher labels every state of episodes run first by itself, then by the student.
     Distil(distil::DistilArgs),
@@ -93,6 +99,7 @@ fn main() -> ExitCode {
         Command::Guide(args) => train::guide(args),
         Command::GoalLead(args) => train::goal_lead(args),
         Command::Handover(args) => train::handover(args),
+        Command::StartGesture(args) => train::start_gesture(args),
         Command::Distil(args) => distil::run(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),

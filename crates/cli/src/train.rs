@@ -10,6 +10,7 @@ use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{ControlRate, CubeRotEnv, GoalLead, LayerOpEnv, StartMix, StartPick};
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::handover::Handover;
+use dexcube_rl::start_gesture::StartGesture;
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
@@ -377,6 +378,55 @@ pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
     Policy::handing_over(&args.policy, handover, &args.out, &command)?;
     println!(
         "{} {handover} into {}",
+        args.policy.display(),
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct StartGestureArgs {
+    /// The policy (single, ensemble, led on or handing over), as the path of its .safetensors
+    /// and .json less the extension.
+    policy: PathBuf,
+    /// The actuators the gesture moves, counted from 0 in the hand's order (1 the wrist's
+    /// flexion; 3, 6, 9 and 13 the first, middle, ring and little fingers' knuckles), comma
+    /// separated.
+    #[arg(long, value_delimiter = ',', required = true)]
+    actuators: Vec<usize>,
+    /// The action they take, from -1 (each joint at its lower limit: a knuckle straight) to 1
+    /// (at its upper); the other actuators take the neutral action, 0.
+    #[arg(long, allow_negative_numbers = true)]
+    action: f64,
+    /// Control steps the gesture lasts before the policy first acts.
+    #[arg(long, default_value_t = 5)]
+    steps: usize,
+    /// Where to write the result (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn start_gesture(args: StartGestureArgs) -> anyhow::Result<ExitCode> {
+    let actuators: Vec<String> = args.actuators.iter().map(usize::to_string).collect();
+    let command = format!(
+        "dexcube start-gesture {} --actuators {} --action {} --steps {} --out {}",
+        args.policy.display(),
+        actuators.join(","),
+        args.action,
+        args.steps,
+        args.out.display()
+    );
+    // The fingertips' side is told from where the physical cube comes to rest on the palm.
+    let resting = dexcube_operator::eval::resting_point()?;
+    let gesture = StartGesture {
+        actuators: args.actuators,
+        action: args.action,
+        steps: args.steps,
+        below_y: resting[1],
+    };
+    Policy::with_start_gesture(&args.policy, gesture.clone(), &args.out, &command)?;
+    println!(
+        "{} making a start gesture, {gesture}, into {}",
         args.policy.display(),
         args.out.display()
     );

@@ -1675,3 +1675,47 @@ fn a_policy_led_on_runs_on_the_goal_led_on() {
     let joined = dexcube(&["ensemble", led, layer, "--out", led], "");
     assert_clean_failure(&joined, 2, "shown its goal led on (by 0.5 within 0.5 rad)");
 }
+
+/// `start-gesture` writes a policy whose card names the gesture and where the cube scene's
+/// resting point lies, and `eval-stage` counts the episodes that began with it; a gesture the
+/// hand cannot make, an action past the actuators' range, a second gesture and a missing
+/// policy fail cleanly.
+#[test]
+fn a_start_gesture_is_written_counted_and_refused_cleanly() {
+    let dir = fresh_dir("dexcube-cli-start-gesture");
+    let [rot, layer] = ["rot", "layer"].map(|name| models().join(name));
+    let [rot, layer] = [&rot, &layer].map(|path| path.to_str().unwrap());
+    let out = dir.join("layer-gesture");
+    let out = out.to_str().unwrap();
+    let gesture = |from: &str, actuators: &str, action: &str| {
+        let args = ["--actuators", actuators, "--action", action, "--steps", "5"];
+        dexcube(
+            &[&["start-gesture", from][..], &args, &["--out", out]].concat(),
+            "",
+        )
+    };
+    let o = gesture(layer, "3,6,9,13", "-1");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("actuators 3,6,9,13 at -1 for the first 5 steps"));
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{out}.json")).unwrap()).unwrap();
+    let below_y = card["start_gesture"]["below_y"].as_f64().unwrap();
+    assert!(
+        (below_y - 0.8766).abs() < 1e-3,
+        "the palm's resting point: {below_y}"
+    );
+    assert_eq!(card["metadata"]["start_gesture"], layer);
+    let (_, printed) = two_episodes(&dir, ("layer", "13000000"), [rot, out]);
+    assert!(
+        printed.contains("began with the start gesture in"),
+        "{printed}"
+    );
+    for (from, actuators, action, says) in [
+        (layer, "3,20", "-1", "not an actuator 20"),
+        (layer, "3", "1.5", "an action is between -1 and 1, not 1.5"),
+        (out, "3", "-1", "makes a start gesture already"),
+        ("no/such/policy", "3", "-1", "no/such/policy.json"),
+    ] {
+        assert_clean_failure(&gesture(from, actuators, action), 2, says);
+    }
+}

@@ -6,7 +6,9 @@ use std::sync::Arc;
 
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
 use dexcube_sim::rotation::Quat;
-use dexcube_sim::{GRIP_PARTS, HAND_ACTUATORS, PhysicsScales, Pose, Scene, SceneKind, Sim};
+use dexcube_sim::{
+    GRIP_PARTS, HAND_ACTUATORS, HAND_JOINTS, PhysicsScales, Pose, Scene, SceneKind, Sim,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -17,6 +19,10 @@ use crate::{ControlRate, Info, Observation, Transition};
 /// Observations shared by both environments: joint angles 24, joint velocities 24, object
 /// position 3, orientation 4, velocity 3, angular velocity 3.
 pub const BASE_OBSERVATION: usize = 61;
+
+/// Where the object's position (x, y, z in world metres) begins in those observations, after
+/// the joint angles and velocities.
+pub const OBJECT_POSITION: usize = 2 * HAND_JOINTS;
 
 /// What a policy is shown beyond its stage's paper observations, appended after them in this
 /// order; both parts are for the physical cube. A trained policy's view is told from the size

@@ -34,8 +34,8 @@ use std::sync::Arc;
 pub use dexcube_sim::SimError;
 pub use goal::{Goal, GoalLead, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{
-    BASE_OBSERVATION, DROP_DEPTH, ObjectKind, SETTLE_STEPS, View, base_observation, is_dropped,
-    is_square, resting_point, set_down,
+    BASE_OBSERVATION, DROP_DEPTH, OBJECT_POSITION, ObjectKind, SETTLE_STEPS, View,
+    base_observation, is_dropped, is_square, resting_point, set_down,
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, achieved_goal, cube_misalignment, pose_goal, rot_observation};

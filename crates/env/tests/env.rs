@@ -4,8 +4,8 @@ use dexcube_env::layer::LayerGoals;
 use dexcube_env::rot::PAPER_TARGETS;
 use dexcube_env::{
     ControlRate, CubeLayer, CubeRotEnv, Goal, GoalEnv, GoalLead, LayerGoal, LayerMove, LayerOpEnv,
-    ObjectKind, RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, VecEnv, View,
-    pose_goal,
+    OBJECT_POSITION, ObjectKind, RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix,
+    StartPick, VecEnv, View, pose_goal,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
@@ -943,4 +943,26 @@ fn varied_physics_draws_each_episodes_scales_from_its_seed() {
     );
     assert_eq!(scales(0.3, 5), drawn, "the same seed, the same physics");
     assert_ne!(scales(0.3, 6), drawn, "another seed, other physics");
+}
+
+/// Both stages show the object's position where [`OBJECT_POSITION`] says, at reset and after
+/// a step, on the rigid cube and the physical one: what a start gesture reads to tell where
+/// the cube sits on the palm.
+#[test]
+fn both_stages_show_the_object_position_where_the_layout_says() {
+    let rot = CubeRotEnv::new(RotMode::Pair).unwrap();
+    let layer =
+        LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
+    let envs: [Box<dyn SimulatedEnv>; 2] = [Box::new(rot), Box::new(layer)];
+    let mut rng = ChaCha8Rng::seed_from_u64(53);
+    for mut env in envs {
+        let shows_its_position = |env: &dyn SimulatedEnv, observation: &[f64]| {
+            let shown = &observation[OBJECT_POSITION..OBJECT_POSITION + 3];
+            assert_eq!(shown, env.sim().object_pose().position);
+        };
+        let (first, _) = env.reset(Some(53));
+        shows_its_position(env.as_ref(), &first.observation);
+        let later = env.step(&random_action(&mut rng)).observation;
+        shows_its_position(env.as_ref(), &later.observation);
+    }
 }

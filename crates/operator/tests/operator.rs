@@ -6,8 +6,8 @@ use dexcube_cube::Face;
 use dexcube_cube::{CostTable, DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{
-    ControlRate, CubeRotEnv, EPISODE_STEPS, LayerOpEnv, RotGoal, RotMode, SimulatedEnv, StartMix,
-    StartPick,
+    ControlRate, CubeRotEnv, EPISODE_STEPS, GoalEnv, LayerOpEnv, OBJECT_POSITION, ObjectKind,
+    RotGoal, RotMode, SimulatedEnv, StartMix, StartPick,
 };
 use dexcube_operator::stages::{
     Driving, KinematicStage1, KinematicStage2, OPENING_STEPS, RecordingStage1, RecordingStage2,
@@ -17,6 +17,8 @@ use dexcube_operator::{
     AlreadyUp, Failure, Operator, OperatorConfig, Outcome, Planner, hand_cost, hand_price,
     move_plan, set_up_scramble,
 };
+use dexcube_rl::Policy;
+use dexcube_rl::start_gesture::StartGesture;
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, snap_layers};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{Pose, Scene, SceneKind, Sim};
@@ -918,4 +920,71 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     );
     stages.stage1.policy.card.metadata["environment"]["control_substeps"] = 3.into();
     assert!(card_rate(&stages).is_err());
+}
+
+/// A policy made from the shipped Stage 2 with a start gesture makes it for its first steps
+/// where the cube starts towards the fingertips, then acts as the shipped one; where the cube
+/// starts elsewhere it acts as the shipped one from the first step. A second gesture, and an
+/// actuator the hand lacks, are refused, and so is training from the gesturing policy, which
+/// would lose the gesture.
+#[test]
+fn a_start_gesture_comes_first_only_towards_the_fingertips() {
+    let (stages, resting) = shipped_stages();
+    let device = burn::prelude::Device::flex();
+    let dir = std::env::temp_dir().join(format!("dexcube-start-gesture-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/layer");
+    let gesture = StartGesture {
+        actuators: vec![3, 6, 9, 13],
+        action: -1.0,
+        steps: 2,
+        below_y: resting[1],
+    };
+    let out = dir.join("layer-gesture");
+    Policy::with_start_gesture(&shipped, gesture.clone(), &out, "test").unwrap();
+    let gesturing = Policy::load(&out, &device).unwrap();
+    assert_eq!(gesturing.card.start_gesture.as_ref(), Some(&gesture));
+    let plain = &stages.stage2.policy;
+    let mut env = LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
+        .unwrap()
+        .with_goal(stages.stage2.goal)
+        .with_view(stages.stage2.view);
+    let test = env.goal();
+    let mut sides_seen = [false; 2];
+    for seed in 0..40 {
+        let (mut obs, _) = env.reset(Some(seed));
+        let towards_tips = obs.observation[OBJECT_POSITION + 1] < resting[1];
+        if std::mem::replace(&mut sides_seen[usize::from(towards_tips)], true) {
+            continue;
+        }
+        let mut acting = gesturing.episode();
+        for step in 1..=4 {
+            let achieved = || obs.achieved_goal.clone();
+            let action =
+                acting.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
+            let expected = if towards_tips && step <= 2 {
+                gesture.action(20)
+            } else {
+                plain.act(&obs.observation, &obs.desired_goal)
+            };
+            assert_eq!(action, expected, "seed {seed}, step {step}");
+            assert_eq!(acting.gestured(), towards_tips);
+            obs = env.step(&action).observation;
+        }
+    }
+    assert_eq!(sides_seen, [true, true], "starts on both sides");
+    let refused = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
+        result.err().unwrap().to_string()
+    };
+    let again = Policy::with_start_gesture(&out, gesture.clone(), &dir.join("x"), "test");
+    assert!(refused(again).contains("makes a start gesture already"));
+    let lacking = StartGesture {
+        actuators: vec![20],
+        ..gesture
+    };
+    let lacking = Policy::with_start_gesture(&shipped, lacking, &dir.join("x"), "test");
+    assert!(refused(lacking).contains("not an actuator 20"));
+    let joined = Policy::ensemble(&[out.clone(), shipped.clone()], &dir.join("x"), "test");
+    assert!(refused(joined).contains("makes a start gesture"));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -35,6 +35,7 @@ pub mod replay;
 pub mod rollout;
 pub mod seeds;
 pub mod start_file;
+pub mod start_gesture;
 pub mod train;
 
 pub use agent::{Agent, Dims, Learners, SavedAnchor};

@@ -25,6 +25,7 @@ use crate::handover::{Handover, HandoverWatch, Turn};
 use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
 use crate::params::{self, NamedTensor};
+use crate::start_gesture::StartGesture;
 
 /// Everything about a policy but its weights.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -48,6 +49,10 @@ pub struct PolicyCard {
     /// The member an ensemble hands a stalled episode to, and when; none for the paper's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub handover: Option<Handover>,
+    /// A gesture the hand makes before the policy first acts, where the cube starts towards
+    /// the fingertips; none for the paper's, which acts from the first step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_gesture: Option<StartGesture>,
 }
 
 /// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
@@ -145,6 +150,15 @@ pub(crate) fn read_single(
             ),
         ));
     }
+    if let Some(gesture) = &card.start_gesture {
+        return Err(mismatch(
+            &weights,
+            format!(
+                "it makes a start gesture ({gesture}) and cannot be {used}: use the policy it \
+                 was made from (its card's metadata.start_gesture names it)"
+            ),
+        ));
+    }
     if let Some(guide) = &card.guide {
         return Err(mismatch(
             &weights,
@@ -175,8 +189,8 @@ impl PolicyCard {
     }
 
     /// What on the card, besides the weights, decides how the policy acts: its guide's
-    /// settings (how many candidates, how far, drawn from which seed), its goal lead and its
-    /// handover.
+    /// settings (how many candidates, how far, drawn from which seed), its goal lead, its
+    /// handover and its start gesture.
     /// None for a policy that acts on its weights alone.
     pub fn acting_settings(&self) -> Option<serde_json::Value> {
         let mut settings = serde_json::Map::new();
@@ -195,6 +209,9 @@ impl PolicyCard {
         }
         if let Some(handover) = &self.handover {
             settings.insert("handover".into(), serde_json::json!(handover));
+        }
+        if let Some(gesture) = &self.start_gesture {
+            settings.insert("start_gesture".into(), serde_json::json!(gesture));
         }
         (!settings.is_empty()).then_some(serde_json::Value::Object(settings))
     }
@@ -232,6 +249,7 @@ impl Policy {
             guide: None,
             goal_lead: None,
             handover: None,
+            start_gesture: None,
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -473,6 +491,29 @@ impl Policy {
         })
     }
 
+    /// Writes at `out` the policy at `policy` (any: single, ensemble, led, handing over)
+    /// making `gesture` before it first acts where the cube starts towards the fingertips
+    /// ([`StartGesture`]); its weights are unchanged. The card records the policy and
+    /// `command`, the command that made it.
+    pub fn with_start_gesture(
+        policy: &Path,
+        gesture: StartGesture,
+        out: &Path,
+        command: &str,
+    ) -> Result<(), CheckpointError> {
+        let how = gesture.to_string();
+        restated(policy, (out, command), ("start_gesture", how), |card| {
+            if card.start_gesture.is_some() {
+                let already =
+                    "it makes a start gesture already: start from the policy it was made from";
+                return Err(already.into());
+            }
+            gesture.check(card.dims)?;
+            card.start_gesture = Some(gesture);
+            Ok(())
+        })
+    }
+
     /// Loads the policy at `prefix` onto `device`.
     pub fn load(prefix: &Path, device: &Device) -> Result<Policy, CheckpointError> {
         let (weights, card, tensors) = read_stored(prefix)?;
@@ -521,6 +562,7 @@ impl Policy {
                 guide: None,
                 goal_lead: None,
                 handover: None,
+                start_gesture: None,
                 ..self.card.clone()
             },
             actor,
@@ -554,6 +596,8 @@ impl Policy {
         Acting {
             policy: self,
             watch: self.card.handover.map(HandoverWatch::new),
+            steps: 0,
+            gesture: None,
         }
     }
 
@@ -602,6 +646,11 @@ impl Policy {
 pub struct Acting<'a> {
     policy: &'a Policy,
     watch: Option<HandoverWatch>,
+    /// Control steps acted so far.
+    steps: usize,
+    /// The start gesture's action and its steps, where this episode makes it (decided at the
+    /// first step).
+    gesture: Option<(Vec<f64>, usize)>,
 }
 
 impl Acting<'_> {
@@ -617,6 +666,20 @@ impl Acting<'_> {
         test: &dyn Goal,
     ) -> Vec<f64> {
         let policy = self.policy;
+        if self.steps == 0 {
+            self.gesture = policy.card.start_gesture.as_ref().and_then(|gesture| {
+                let action = gesture.action(policy.card.dims.action);
+                gesture
+                    .applies(observation)
+                    .then_some((action, gesture.steps))
+            });
+        }
+        self.steps += 1;
+        if let Some((action, steps)) = &self.gesture
+            && self.steps <= *steps
+        {
+            return action.clone();
+        }
         let lead = policy.card.goal_lead;
         if lead.is_none() && self.watch.is_none() {
             return policy.act(observation, desired);
@@ -642,6 +705,11 @@ impl Acting<'_> {
             ) => policy.member_action(first, observation, &shown),
             _ => policy.act(observation, &shown),
         }
+    }
+
+    /// Whether the episode began with the start gesture.
+    pub fn gestured(&self) -> bool {
+        self.gesture.is_some()
     }
 
     /// Whether the episode has been handed to a member.
