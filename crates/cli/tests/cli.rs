@@ -1677,9 +1677,9 @@ fn a_policy_led_on_runs_on_the_goal_led_on() {
 }
 
 /// `start-gesture` writes a policy whose card names the gesture and where the cube scene's
-/// resting point lies, and `eval-stage` counts the episodes that began with it; a gesture the
-/// hand cannot make, an action past the actuators' range, a second gesture and a missing
-/// policy fail cleanly.
+/// resting point lies, and `eval-stage` counts the episodes that began with it; `distil`
+/// refuses it as a teacher, and a gesture the hand cannot make, an action past the actuators'
+/// range, a second gesture and a missing policy fail cleanly.
 #[test]
 fn a_start_gesture_is_written_counted_and_refused_cleanly() {
     let dir = fresh_dir("dexcube-cli-start-gesture");
@@ -1710,6 +1710,20 @@ fn a_start_gesture_is_written_counted_and_refused_cleanly() {
         printed.contains("began with the start gesture in"),
         "{printed}"
     );
+    let student = dir.join("student");
+    let distil = [
+        &[
+            "distil",
+            "layer",
+            "--rot-policy",
+            rot,
+            "--layer-policy",
+            out,
+        ][..],
+        &["--out", student.to_str().unwrap()],
+    ]
+    .concat();
+    assert_clean_failure(&dexcube(&distil, ""), 2, "makes a start gesture");
     for (from, actuators, action, says) in [
         (layer, "3,20", "-1", "not an actuator 20"),
         (layer, "3", "1.5", "an action is between -1 and 1, not 1.5"),

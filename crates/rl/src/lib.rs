@@ -13,6 +13,10 @@
 //! - [`seeds`]: learning curves across seeds, mean ± one standard deviation;
 //! - [`policy`]: a trained actor as shipped, with its normalisers;
 //! - [`guide`]: a run's critics choosing among actions near a policy's own;
+//! - [`handover`]: an ensemble handing a stalled episode to one member, or a policy letting go
+//!   and trying again;
+//! - [`start_gesture`]: a gesture the hand makes before a policy first acts, where the cube
+//!   starts towards the fingertips;
 //! - [`distil`]: one actor fitted to act as another policy (an ensemble) does, by DAgger;
 //! - [`point_mass`]: a small reaching task that proves the learner in seconds.
 //!

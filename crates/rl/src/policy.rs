@@ -654,10 +654,11 @@ pub struct Acting<'a> {
 }
 
 impl Acting<'_> {
-    /// The deterministic action toward `desired` for one observation, judged by `test`: shown
-    /// the goal led on where the card says so, from the object's goal now, and by the member
-    /// handed over to once the episode has stalled, where it says so; `achieved` reads the
-    /// object's goal only for these.
+    /// The deterministic action toward `desired` for one observation, judged by `test`: the
+    /// start gesture's for its first steps where the card has one and the cube started towards
+    /// the fingertips; then shown the goal led on where the card says so, from the object's
+    /// goal now, and by the member handed over to once the episode has stalled, where it says
+    /// so; `achieved` reads the object's goal only for these.
     pub fn act_toward(
         &mut self,
         observation: &[f64],
