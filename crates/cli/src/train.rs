@@ -407,15 +407,6 @@ pub struct StartGestureArgs {
 }
 
 pub fn start_gesture(args: StartGestureArgs) -> anyhow::Result<ExitCode> {
-    let actuators: Vec<String> = args.actuators.iter().map(usize::to_string).collect();
-    let command = format!(
-        "dexcube start-gesture {} --actuators {} --action {} --steps {} --out {}",
-        args.policy.display(),
-        actuators.join(","),
-        args.action,
-        args.steps,
-        args.out.display()
-    );
     // The fingertips' side is told from where the physical cube comes to rest on the palm.
     let resting = dexcube_operator::eval::resting_point()?;
     let gesture = StartGesture {
@@ -424,6 +415,14 @@ pub fn start_gesture(args: StartGestureArgs) -> anyhow::Result<ExitCode> {
         steps: args.steps,
         below_y: resting[1],
     };
+    let command = format!(
+        "dexcube start-gesture {} --actuators {} --action {} --steps {} --out {}",
+        args.policy.display(),
+        gesture.actuator_list(),
+        gesture.action,
+        gesture.steps,
+        args.out.display()
+    );
     Policy::with_start_gesture(&args.policy, gesture.clone(), &args.out, &command)?;
     println!(
         "{} making a start gesture, {gesture}, into {}",

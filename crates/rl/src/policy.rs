@@ -646,11 +646,11 @@ impl Policy {
 pub struct Acting<'a> {
     policy: &'a Policy,
     watch: Option<HandoverWatch>,
-    /// Control steps acted so far.
+    /// Control steps acted so far, counted where the card has a start gesture.
     steps: usize,
-    /// The start gesture's action and its steps, where this episode makes it (decided at the
-    /// first step).
-    gesture: Option<(Vec<f64>, usize)>,
+    /// The start gesture's action, where this episode makes it (decided at the first step; it
+    /// lasts the card's `start_gesture.steps`).
+    gesture: Option<Vec<f64>>,
 }
 
 impl Acting<'_> {
@@ -667,19 +667,16 @@ impl Acting<'_> {
         test: &dyn Goal,
     ) -> Vec<f64> {
         let policy = self.policy;
-        if self.steps == 0 {
-            self.gesture = policy.card.start_gesture.as_ref().and_then(|gesture| {
-                let action = gesture.action(policy.card.dims.action);
-                gesture
-                    .applies(observation)
-                    .then_some((action, gesture.steps))
-            });
-        }
-        self.steps += 1;
-        if let Some((action, steps)) = &self.gesture
-            && self.steps <= *steps
-        {
-            return action.clone();
+        if let Some(gesture) = &policy.card.start_gesture {
+            if self.steps == 0 && gesture.applies(observation) {
+                self.gesture = Some(gesture.action(policy.card.dims.action));
+            }
+            self.steps += 1;
+            if let Some(action) = &self.gesture
+                && self.steps <= gesture.steps
+            {
+                return action.clone();
+            }
         }
         let lead = policy.card.goal_lead;
         if lead.is_none() && self.watch.is_none() {

@@ -32,11 +32,10 @@ pub struct StartGesture {
 /// What the gesture does, in words, for a policy's card and the command that makes it.
 impl std::fmt::Display for StartGesture {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let actuators: Vec<String> = self.actuators.iter().map(usize::to_string).collect();
         write!(
             f,
             "actuators {} at {} for the first {} steps where the cube starts with y below {}",
-            actuators.join(","),
+            self.actuator_list(),
             self.action,
             self.steps,
             self.below_y
@@ -45,6 +44,12 @@ impl std::fmt::Display for StartGesture {
 }
 
 impl StartGesture {
+    /// The actuators, comma separated, as `dexcube start-gesture --actuators` takes them.
+    pub fn actuator_list(&self) -> String {
+        let actuators: Vec<String> = self.actuators.iter().map(usize::to_string).collect();
+        actuators.join(",")
+    }
+
     /// The action of the gesture for a hand of `actions` actuators.
     pub fn action(&self, actions: usize) -> Vec<f64> {
         let mut out = vec![0.0; actions];
