@@ -743,8 +743,16 @@ pub struct EvalStageArgs {
     /// its goal) into this file, each marked failed as `eval` marks the stage's starts, for
     /// `train --starts`: training can then draw the placements this policy failed from more
     /// often. Record with seeds that no evaluation uses.
-    #[arg(long, value_name = "FILE", conflicts_with = "starts")]
+    #[arg(long, value_name = "FILE")]
     record_starts: Option<PathBuf>,
+    /// With --record-starts and a policy with a start gesture (`dexcube start-gesture`):
+    /// record an episode that makes the gesture where the policy first acts after it (the
+    /// physics state after the gesture's last step, the goal, and the angle the layer turned
+    /// meanwhile), so that `train --starts` can teach the policy's actor, which makes no
+    /// gesture, from where the gesture leaves the cube. Such starts are for the actor alone:
+    /// replayed with the gesturing policy, the gesture would be made twice.
+    #[arg(long, requires = "record_starts")]
+    after_gesture: bool,
     /// Stage 1 only: also record, for every episode that missed its pose and kept the cube,
     /// where it came closest to the pose (the physics state after the step with the smallest
     /// angle from the goal, and the goal), marked failed, for `train --starts`: the states
@@ -902,11 +910,13 @@ struct EpisodeTrace {
     gestured: bool,
 }
 
-/// What an episode keeps of its physics, for `--record-starts`, `--record-closest` and
+/// What an episode keeps of its physics, for `--record-starts` (where the policy first acts
+/// after its start gesture with `--after-gesture`), `--record-closest` and
 /// `--record-handovers`.
 #[derive(Clone, Copy, Default)]
 struct Keep {
     start: bool,
+    after_gesture: bool,
     closest: bool,
     handover: bool,
 }
@@ -923,7 +933,7 @@ fn episode(
     watch: &mut dyn FnMut(&mut Sim),
 ) -> EpisodeTrace {
     let (mut obs, start_info) = env.reset(Some(seed));
-    let start = keep.start.then(|| env.fresh_start());
+    let mut start = keep.start.then(|| env.fresh_start());
     let puzzle_at_start = read_puzzle(env.sim());
     let (mut hold, mut longest_hold) = (0, 0);
     let (mut steps, mut first_at_goal) = (0, None);
@@ -943,6 +953,9 @@ fn episode(
         let t = env.step(&action);
         watch(env.sim_mut());
         steps += 1;
+        if keep.after_gesture && acting.gesture_just_made() {
+            start = Some(env.fresh_start());
+        }
         hold = if meets_paper_test(&t.info, thresholds) {
             first_at_goal.get_or_insert(steps);
             hold + 1
@@ -1046,6 +1059,20 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             prefix.display()
         );
     }
+    if args.record_starts.is_some() && args.starts.is_some() && !args.after_gesture {
+        bail!(
+            "--record-starts with --starts would write the starts it replays again: drop one, \
+             or add --after-gesture to record where a gesturing policy first acts after its \
+             gesture"
+        );
+    }
+    if args.after_gesture && start_gesture.is_none() {
+        bail!(
+            "--after-gesture records where the policy first acts after its start gesture, and \
+             {} makes none: make one that does with `dexcube start-gesture`",
+            prefix.display()
+        );
+    }
     let (starts, failure) = match &args.starts {
         None => (None, args.stage.recorded_failure()),
         Some(path) => {
@@ -1070,6 +1097,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let rows = Mutex::new(Vec::new());
     let keep = Keep {
         start: args.record_starts.is_some(),
+        after_gesture: args.after_gesture,
         closest: args.record_closest.is_some(),
         handover: args.record_handovers.is_some(),
     };
@@ -1294,6 +1322,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     // Writes what the episodes recorded, in episode order, and returns it.
+    let replayed = args.starts.as_ref().map_or(String::new(), |path| {
+        format!(" --starts {}", path.display())
+    });
     let save = |flag: &str, path: &Path, recorded: Mutex<Vec<(usize, RecordedStart)>>| {
         let starts = in_episode_order(recorded);
         let origin = StartsOrigin {
@@ -1301,7 +1332,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             failure,
             scene: object.scene().name().to_string(),
             command: format!(
-                "{} {flag} {}",
+                "{}{replayed} {flag} {}",
                 stage_command(&args, object, &prefix),
                 path.display()
             ),
@@ -1309,7 +1340,11 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         save_starts(path, &starts, &origin).map(|()| starts)
     };
     if let Some(path) = &args.record_starts {
-        let starts = save("--record-starts", path, recorded)?;
+        let flag = match args.after_gesture {
+            true => "--after-gesture --record-starts",
+            false => "--record-starts",
+        };
+        let starts = save(flag, path, recorded)?;
         let failed = starts.iter().filter(|s| s.failed).count();
         println!(
             "  recorded the {} starts (from {failed} of which this policy {}) in {}",

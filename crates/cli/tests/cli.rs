@@ -294,6 +294,69 @@ fn eval_writes_its_table_and_a_rerun_continues_it() {
     assert!(md.contains("--seed 5 --rot-policy"), "{md}");
 }
 
+/// `eval-stage --after-gesture --record-starts` with the gesturing policy `gesturing` (made
+/// from `layer`) keeps, for an episode that makes the gesture, the state after it with the
+/// angle the layer turned meanwhile, and for one that does not, its fresh placement as
+/// `--record-starts` alone keeps it, marked failed alike; it refuses a policy with no
+/// gesture, and `--record-starts` with `--starts` is refused without it.
+fn after_gesture_starts_are_where_the_policy_first_acts(
+    dir: &std::path::Path,
+    [rot, layer, gesturing]: [&str; 3],
+) {
+    let files = ["fresh", "after"].map(|name| dir.join(format!("{name}.safetensors")));
+    let [fresh, after] = files.each_ref().map(|file| file.to_str().unwrap());
+    let record = |policy: &str, flags: &[&str]| {
+        let args = ["eval-stage", "layer", "--episodes", "8", "--threads", "2"];
+        let policies = [
+            "--seed",
+            "13000000",
+            "--rot-policy",
+            rot,
+            "--layer-policy",
+            policy,
+        ];
+        dexcube(&[&args[..], &policies, flags].concat(), "")
+    };
+    let o = record(gesturing, &["--record-starts", fresh]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = record(gesturing, &["--after-gesture", "--record-starts", after]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let printed = stdout(&o);
+    let load = |file: &std::path::Path| dexcube_rl::start_file::load_starts(file).unwrap();
+    let ((fresh_starts, _), (after_starts, origin)) = (load(&files[0]), load(&files[1]));
+    assert!(origin.command.contains("--after-gesture --record-starts"));
+    let moved: Vec<usize> = (0..8)
+        .filter(|&k| fresh_starts[k].state != after_starts[k].state)
+        .collect();
+    assert!(
+        printed.contains(&format!(
+            "began with the start gesture in {} episodes",
+            moved.len()
+        )) && (1..8).contains(&moved.len()),
+        "{printed}"
+    );
+    for (k, (fresh, after)) in fresh_starts.iter().zip(&after_starts).enumerate() {
+        assert_eq!(fresh.goal[1], 0.0, "a fresh placement has turned nothing");
+        assert_eq!(fresh.failed, after.failed, "episode {k}");
+        if moved.contains(&k) {
+            assert_ne!(
+                after.goal[1], 0.0,
+                "the layer moves while the gesture is made"
+            );
+        } else {
+            assert_eq!(fresh, after, "episode {k}");
+        }
+    }
+    let o = record(layer, &["--after-gesture", "--record-starts", after]);
+    assert_clean_failure(
+        &o,
+        2,
+        "makes none: make one that does with `dexcube start-gesture`",
+    );
+    let o = record(gesturing, &["--starts", fresh, "--record-starts", after]);
+    assert_clean_failure(&o, 2, "would write the starts it replays again");
+}
+
 /// `eval-stage --record-starts` keeps where each fresh episode began, marked failed as the
 /// stage's starts are; running the same policy from that file replays every episode: the
 /// same successes, and a failure from exactly the starts marked failed.
@@ -1724,6 +1787,7 @@ fn a_start_gesture_is_written_counted_and_refused_cleanly() {
     ]
     .concat();
     assert_clean_failure(&dexcube(&distil, ""), 2, "makes a start gesture");
+    after_gesture_starts_are_where_the_policy_first_acts(&dir, [rot, layer, out]);
     for (from, actuators, action, says) in [
         (layer, "3,20", "-1", "not an actuator 20"),
         (layer, "3", "1.5", "an action is between -1 and 1, not 1.5"),

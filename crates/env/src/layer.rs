@@ -466,12 +466,17 @@ impl SimulatedEnv for LayerOpEnv {
         &mut self.hand.sim
     }
 
-    /// The goal holds the quarter turn asked for and no angle already turned: a fresh
-    /// reset counts the layer from where it lies.
+    /// The goal holds the quarter turn asked for and the angle the physical cube's layer has
+    /// turned since the episode began (none right after a fresh reset, which counts the layer
+    /// from where it lies; the block's hinge is read whole, so none there either).
     fn fresh_start(&self) -> RecordedStart {
+        let turned = match &self.layer {
+            Layer::Cube(tracker) => tracker.turned(),
+            Layer::Block { .. } => 0.0,
+        };
         RecordedStart {
             state: self.hand.sim.physics_state(),
-            goal: vec![self.desired, 0.0],
+            goal: vec![self.desired, turned],
             failed: false,
         }
     }

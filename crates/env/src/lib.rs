@@ -166,6 +166,8 @@ pub trait SimulatedEnv: GoalEnv {
     /// marked failed). `eval-stage --record-starts` keeps them, so that training can draw
     /// again the fresh placements a policy failed from. CubeRotEnv's goal holds through an
     /// episode, so for Stage 1 it is also a start at any later step: `eval-stage
-    /// --record-closest` keeps the one nearest the pose.
+    /// --record-closest` keeps the one nearest the pose. LayerOpEnv's holds the angle the
+    /// layer has turned since the episode began, so that a later step is a start too
+    /// (`eval-stage --record-starts --after-gesture`).
     fn fresh_start(&self) -> RecordedStart;
 }

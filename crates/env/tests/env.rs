@@ -966,3 +966,31 @@ fn both_stages_show_the_object_position_where_the_layout_says() {
         shows_its_position(env.as_ref(), &later.observation);
     }
 }
+
+/// A start LayerOpEnv gives in mid-episode holds the angle its physical cube's layer has
+/// turned since the episode began, and an episode reset from it restores the physics and
+/// counts on from that angle: what `eval-stage --after-gesture` records.
+#[test]
+fn a_stage_2_start_taken_in_mid_episode_counts_on_from_the_angle_turned() {
+    let new_env =
+        || LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation).unwrap();
+    let mut env = new_env();
+    env.reset(Some(54));
+    assert_eq!(
+        env.fresh_start().goal[1],
+        0.0,
+        "nothing turned at a fresh reset"
+    );
+    let mut rng = ChaCha8Rng::seed_from_u64(54);
+    let mut turned = 0.0;
+    for _ in 0..10 {
+        turned = env.step(&random_action(&mut rng)).observation.achieved_goal[0];
+    }
+    assert_ne!(turned, 0.0, "ten random steps move the layer");
+    let start = env.fresh_start();
+    assert_eq!(start.goal[1], turned);
+    let mut resumed = new_env();
+    let (first, _) = resumed.reset_from(&start).unwrap();
+    assert_eq!(first.achieved_goal[0], turned);
+    assert_eq!(resumed.sim().physics_state(), start.state);
+}

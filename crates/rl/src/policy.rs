@@ -710,6 +710,13 @@ impl Acting<'_> {
         self.gesture.is_some()
     }
 
+    /// Whether the action last given was the start gesture's last: the policy itself acts
+    /// next, from the state that action leads to.
+    pub fn gesture_just_made(&self) -> bool {
+        self.gestured()
+            && self.policy.card.start_gesture.as_ref().map(|g| g.steps) == Some(self.steps)
+    }
+
     /// Whether the episode has been handed to a member.
     pub fn handed_over(&self) -> bool {
         self.watch.as_ref().is_some_and(HandoverWatch::handed_over)
