@@ -135,13 +135,45 @@ impl CubeLayer {
     pub fn start(sim: &Sim, facing: [f64; 3], base: Quat) -> Option<CubeLayer> {
         let state = CubeState::read(sim)?;
         let face = face_toward(&state.pose().orientation, facing);
-        Some(CubeLayer {
+        Some(CubeLayer::turning(&state, face, base))
+    }
+
+    /// Starts counting from the cube as `state` reads it, with `face`'s layer the one that
+    /// turns.
+    fn turning(state: &CubeState, face: Face, base: Quat) -> CubeLayer {
+        CubeLayer {
             base,
             face,
             last: state.layer_angle(face),
             turned: 0.0,
             view: View::PAPER,
-        })
+        }
+    }
+
+    /// Goes on counting from a recorded start's `goal` (see [`CubeLayer::start_goal`]): the
+    /// layer of the face it names turns, counted from the angle it had turned. A goal from
+    /// before session 54 names no face: the face now toward `facing` turns, as it did when
+    /// such a start was recorded unless the cube had tipped since its stage began.
+    /// `None` if the simulation is not of the `cube` scene.
+    pub fn resume(sim: &Sim, goal: &[f64], facing: [f64; 3], base: Quat) -> Option<CubeLayer> {
+        let state = CubeState::read(sim)?;
+        let named = goal.get(2).and_then(|&code| {
+            (code.fract() == 0.0 && code >= 0.0)
+                .then(|| Face::ALL.get(code as usize).copied())
+                .flatten()
+        });
+        let face = named.unwrap_or_else(|| face_toward(&state.pose().orientation, facing));
+        let turned = goal.get(1).copied().unwrap_or(0.0);
+        Some(CubeLayer::turning(&state, face, base).counted_from(turned))
+    }
+
+    /// The goal a recorded start of Stage 2 holds ([`RecordedStart::goal`]): the layer angle
+    /// to turn, `turned`, the angle the layer had turned when recorded, and the face whose
+    /// layer turns (its place in `Face::ALL`), since a start recorded in mid-stage may find
+    /// the cube tipped so that another face is up.
+    pub fn start_goal(&self, desired: f64, turned: f64) -> Vec<f64> {
+        let code = Face::ALL.iter().position(|&face| face == self.face);
+        vec![desired, turned, code.expect("one of the six faces") as f64]
     }
 
     /// The same, showing `view` after the layer angle.
@@ -343,17 +375,18 @@ impl LayerOpEnv {
     pub fn reset_from(&mut self, start: &RecordedStart) -> Result<(Observation, Info), SimError> {
         self.hand.sim.restore_physics_state(&start.state)?;
         self.hand.steps = 0;
-        Ok(self.first_observation(start.goal.get(1).copied().unwrap_or(0.0)))
+        Ok(self.first_observation(&start.goal))
     }
 
-    /// Begins counting the layer from the object as it now lies, as already turned by
-    /// `turned`, draws the goal, and gives the episode's first observation and its info.
-    fn first_observation(&mut self, turned: f64) -> (Observation, Info) {
+    /// Begins counting the layer from the object as it now lies, or as a recorded start's
+    /// `goal` says (the face that turns, and the angle it has turned: [`CubeLayer::resume`];
+    /// a fresh reset's is empty), draws the goal, and gives the episode's first observation
+    /// and its info.
+    fn first_observation(&mut self, goal: &[f64]) -> (Observation, Info) {
         let (facing, base) = (self.layer_move.facing(), self.layer_move.base_orientation());
         if let Layer::Cube(tracker) = &mut self.layer {
-            *tracker = CubeLayer::start(&self.hand.sim, facing, base)
+            *tracker = CubeLayer::resume(&self.hand.sim, goal, facing, base)
                 .expect("a cube scene")
-                .counted_from(turned)
                 .with_view(tracker.view);
         }
         let size = match self.goals {
@@ -466,17 +499,18 @@ impl SimulatedEnv for LayerOpEnv {
         &mut self.hand.sim
     }
 
-    /// The goal holds the quarter turn asked for and the angle the physical cube's layer has
-    /// turned since the episode began (none right after a fresh reset, which counts the layer
-    /// from where it lies; the block's hinge is read whole, so none there either).
+    /// The goal holds the quarter turn asked for, and on the physical cube the angle its
+    /// layer has turned since the episode began (none right after a fresh reset) and the face
+    /// whose layer turns ([`CubeLayer::start_goal`]); the block's hinge is read whole, so
+    /// none there.
     fn fresh_start(&self) -> RecordedStart {
-        let turned = match &self.layer {
-            Layer::Cube(tracker) => tracker.turned(),
-            Layer::Block { .. } => 0.0,
+        let goal = match &self.layer {
+            Layer::Cube(tracker) => tracker.start_goal(self.desired, tracker.turned()),
+            Layer::Block { .. } => vec![self.desired, 0.0],
         };
         RecordedStart {
             state: self.hand.sim.physics_state(),
-            goal: vec![self.desired, turned],
+            goal,
             failed: false,
         }
     }
@@ -523,7 +557,7 @@ impl GoalEnv for LayerOpEnv {
             };
             rotation::normalise(&rotation::mul(&rotation::mul(&spin, &base), &face))
         });
-        self.first_observation(0.0)
+        self.first_observation(&[])
     }
 
     fn step(&mut self, action: &[f64]) -> Transition {

@@ -18,7 +18,9 @@ pub struct RecordedStart {
     pub state: Vec<f64>,
     /// The goal asked for: for Stage 1 the pose, position then quaternion (CubeRotEnv's
     /// 7-number pose goal); for Stage 2 the layer angle to turn (+π/2, U'), then the angle
-    /// the layer had already turned when the policy took over, which its view counts from.
+    /// the layer had already turned when the policy took over, which its view counts from,
+    /// then (since session 54) the face whose layer turns, its place in `Face::ALL`
+    /// ([`CubeLayer::start_goal`](crate::CubeLayer::start_goal)).
     pub goal: Vec<f64>,
     /// Whether the policy that was recorded failed from here, in the way its file's
     /// [`RecordedFailure`] says.

@@ -149,9 +149,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let info = loop {
             if KEPT_STEPS.contains(&step) {
                 kept.push(RecordedStart {
-                    state: env.sim().physics_state(),
-                    goal: vec![FRAC_PI_2, observation.achieved_goal[0]],
                     failed: true,
+                    ..env.fresh_start()
                 });
             }
             let action = policy.act(&observation.observation, &observation.desired_goal);

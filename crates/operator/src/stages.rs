@@ -525,9 +525,9 @@ impl Stage1 for RecordingStage1<'_> {
 }
 
 /// A Stage 2 that records where each of its runs hands over to the policy: the physics state
-/// once the hand has opened (after [`OPENING_STEPS`]), the quarter turn asked for and the
+/// once the hand has opened (after [`OPENING_STEPS`]), the quarter turn asked for, the
 /// angle the layer had already turned while the hand opened (the policy's view counts from
-/// the stage's start), and whether the run then failed by the square test
+/// the stage's start) and the face whose layer turns, and whether the run then failed by the square test
 /// ([`LayerGoal::square`]: the top layer turned within 0.1 rad of U', with the cube in its
 /// good state, and not dropped). A run that dropped the cube while the hand opened records
 /// nothing.
@@ -561,7 +561,7 @@ impl Stage2 for RecordingStage2<'_> {
             );
             self.starts.push(RecordedStart {
                 state,
-                goal: vec![FRAC_PI_2, opened],
+                goal: view.start_goal(FRAC_PI_2, opened),
                 failed: run.dropped || run.diverged || !reached,
             });
         }
