@@ -167,7 +167,7 @@ pub trait SimulatedEnv: GoalEnv {
     /// again the fresh placements a policy failed from. CubeRotEnv's goal holds through an
     /// episode, so for Stage 1 it is also a start at any later step: `eval-stage
     /// --record-closest` keeps the one nearest the pose. LayerOpEnv's holds the angle the
-    /// layer has turned since the episode began, so that a later step is a start too
-    /// (`eval-stage --record-starts --after-gesture`).
+    /// layer has turned since the episode began and the face whose layer turns, so that a
+    /// later step is a start too (`eval-stage --record-starts --after-gesture`).
     fn fresh_start(&self) -> RecordedStart;
 }

@@ -17,7 +17,6 @@
 //! `cargo run --release -p dexcube-operator --example stage2_jams -- POLICY
 //! (--fresh SEED EPISODES | --failed-starts FILE) [--slew S] [--keep-jams OUT] [--steps N]`
 
-use std::f64::consts::FRAC_PI_2;
 use std::path::{Path, PathBuf};
 
 use dexcube_env::layer::LayerGoals;
