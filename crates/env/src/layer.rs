@@ -133,47 +133,38 @@ impl CubeLayer {
     /// one that turns; `base` is the orientation the observed frame is kept nearest to.
     /// `None` if the simulation is not of the `cube` scene.
     pub fn start(sim: &Sim, facing: [f64; 3], base: Quat) -> Option<CubeLayer> {
-        let state = CubeState::read(sim)?;
-        let face = face_toward(&state.pose().orientation, facing);
-        Some(CubeLayer::turning(&state, face, base))
-    }
-
-    /// Starts counting from the cube as `state` reads it, with `face`'s layer the one that
-    /// turns.
-    fn turning(state: &CubeState, face: Face, base: Quat) -> CubeLayer {
-        CubeLayer {
-            base,
-            face,
-            last: state.layer_angle(face),
-            turned: 0.0,
-            view: View::PAPER,
-        }
+        CubeLayer::resume(sim, &[], facing, base)
     }
 
     /// Goes on counting from a recorded start's `goal` (see [`CubeLayer::start_goal`]): the
-    /// layer of the face it names turns, counted from the angle it had turned. A goal from
-    /// before session 54 names no face: the face now toward `facing` turns, as it did when
-    /// such a start was recorded unless the cube had tipped since its stage began.
+    /// layer of the face it names turns, counted from the angle it had turned. A goal that
+    /// names no face (a fresh start's, or one recorded before session 54) turns the face now
+    /// toward `facing`, as such a start did unless the cube had tipped since its stage began.
     /// `None` if the simulation is not of the `cube` scene.
     pub fn resume(sim: &Sim, goal: &[f64], facing: [f64; 3], base: Quat) -> Option<CubeLayer> {
         let state = CubeState::read(sim)?;
-        let named = goal.get(2).and_then(|&code| {
-            (code.fract() == 0.0 && code >= 0.0)
-                .then(|| Face::ALL.get(code as usize).copied())
-                .flatten()
-        });
-        let face = named.unwrap_or_else(|| face_toward(&state.pose().orientation, facing));
-        let turned = goal.get(1).copied().unwrap_or(0.0);
-        Some(CubeLayer::turning(&state, face, base).counted_from(turned))
+        let named = goal
+            .get(2)
+            .filter(|code| code.fract() == 0.0 && **code >= 0.0)
+            .and_then(|&code| Face::ALL.get(code as usize));
+        let face = named
+            .copied()
+            .unwrap_or_else(|| face_toward(&state.pose().orientation, facing));
+        Some(CubeLayer {
+            base,
+            face,
+            last: state.layer_angle(face),
+            turned: goal.get(1).copied().unwrap_or(0.0),
+            view: View::PAPER,
+        })
     }
 
     /// The goal a recorded start of Stage 2 holds ([`RecordedStart::goal`]): the layer angle
-    /// to turn, `turned`, the angle the layer had turned when recorded, and the face whose
-    /// layer turns (its place in `Face::ALL`), since a start recorded in mid-stage may find
-    /// the cube tipped so that another face is up.
-    pub fn start_goal(&self, desired: f64, turned: f64) -> Vec<f64> {
-        let code = Face::ALL.iter().position(|&face| face == self.face);
-        vec![desired, turned, code.expect("one of the six faces") as f64]
+    /// to turn, the angle the layer has turned so far, and the face whose layer turns (its
+    /// place in `Face::ALL`), since a start recorded in mid-stage may find the cube tipped so
+    /// that another face is up.
+    pub fn start_goal(&self, desired: f64) -> Vec<f64> {
+        vec![desired, self.turned, self.face as usize as f64]
     }
 
     /// The same, showing `view` after the layer angle.
@@ -190,13 +181,6 @@ impl CubeLayer {
     /// How many inputs this view gives the policy.
     pub fn observation_size(&self) -> usize {
         CubeLayer::PAPER_OBSERVATION + self.view.size()
-    }
-
-    /// The same count, as if the layer had already turned by `turned` (a recorded start
-    /// resumes the count where the operator's view had it).
-    pub fn counted_from(mut self, turned: f64) -> CubeLayer {
-        self.turned = turned;
-        self
     }
 
     /// The observations: the 62 (the layer angle turned so far last), then what the view
@@ -505,7 +489,7 @@ impl SimulatedEnv for LayerOpEnv {
     /// none there.
     fn fresh_start(&self) -> RecordedStart {
         let goal = match &self.layer {
-            Layer::Cube(tracker) => tracker.start_goal(self.desired, tracker.turned()),
+            Layer::Cube(tracker) => tracker.start_goal(self.desired),
             Layer::Block { .. } => vec![self.desired, 0.0],
         };
         RecordedStart {

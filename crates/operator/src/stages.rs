@@ -527,9 +527,9 @@ impl Stage1 for RecordingStage1<'_> {
 /// A Stage 2 that records where each of its runs hands over to the policy: the physics state
 /// once the hand has opened (after [`OPENING_STEPS`]), the quarter turn asked for, the
 /// angle the layer had already turned while the hand opened (the policy's view counts from
-/// the stage's start) and the face whose layer turns, and whether the run then failed by the square test
-/// ([`LayerGoal::square`]: the top layer turned within 0.1 rad of U', with the cube in its
-/// good state, and not dropped). A run that dropped the cube while the hand opened records
+/// the stage's start) and the face whose layer turns, and whether the run then failed by the
+/// square test ([`LayerGoal::square`]: the top layer turned within 0.1 rad of U', with the
+/// cube in its good state, and not dropped). A run that dropped the cube while the hand opened records
 /// nothing.
 pub struct RecordingStage2<'a> {
     pub inner: &'a mut dyn Stage2,
@@ -546,13 +546,13 @@ impl Stage2 for RecordingStage2<'_> {
             watch(sim);
             steps += 1;
             // Every step, so that the layer angle unwraps as the policy's own view does.
-            let turned = view.follow(sim);
+            view.follow(sim);
             if steps == OPENING_STEPS {
-                start = Some((sim.physics_state(), turned));
+                start = Some((sim.physics_state(), view.start_goal(FRAC_PI_2)));
             }
         };
         let run = self.inner.run(sim, &mut recording);
-        if let Some((state, opened)) = start {
+        if let Some((state, goal)) = start {
             let test = LayerGoal::square();
             let misalignment = CubeState::read(sim).map_or(f64::INFINITY, |c| c.misalignment());
             let reached = test.is_success(
@@ -561,7 +561,7 @@ impl Stage2 for RecordingStage2<'_> {
             );
             self.starts.push(RecordedStart {
                 state,
-                goal: view.start_goal(FRAC_PI_2, opened),
+                goal,
                 failed: run.dropped || run.diverged || !reached,
             });
         }
