@@ -7,8 +7,8 @@ use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    ControlRate, CubeRotEnv, GoalEnv, LayerGoal, LayerMove, LayerOpEnv, ObjectKind,
-    RecordedFailure, RotGoal, RotMode, View,
+    ControlRate, CubeRotEnv, EpisodeSettings, GoalEnv, LayerGoal, LayerMove, LayerOpEnv,
+    ObjectKind, RecordedFailure, RotGoal, RotMode, View,
 };
 use dexcube_sim::Scene;
 use rand::{Rng, SeedableRng};
@@ -138,17 +138,21 @@ impl EnvChoice {
     /// Builds the chosen environment; LayerOpEnv samples training goals.
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
         let scene = Scene::load(self.object()?.scene())?;
+        let settings = EpisodeSettings {
+            rate: self.control_rate,
+            ..EpisodeSettings::PAPER
+        };
         Ok(match self.env {
             EnvKind::Rot => Box::new(
                 CubeRotEnv::with_scene(scene, self.rot_goal()?)
                     .with_view(self.view()?)
-                    .with_control_rate(self.control_rate),
+                    .with_settings(settings),
             ),
             EnvKind::Layer => Box::new(
                 LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
                     .with_goal(self.layer_goal()?)
                     .with_view(self.view()?)
-                    .with_control_rate(self.control_rate),
+                    .with_settings(settings),
             ),
         })
     }

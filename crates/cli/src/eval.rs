@@ -1014,7 +1014,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     // Episodes that began with a start gesture, and of them successes.
     let (gestures, successes_gestured) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
-    let (thresholds, control_rate) = (setup.thresholds, setup.control_rate);
+    let (thresholds, control_rate) = (setup.thresholds, setup.settings.rate);
     if args.record && args.physics_spread > 0.0 {
         bail!(
             "--record writes the policy's evaluation on the scene's own physics, not under \
@@ -1022,14 +1022,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             args.physics_spread
         );
     }
-    setup.physics_spread = args.physics_spread;
+    setup.settings.physics_spread = args.physics_spread;
     if args.record && args.episode_steps.is_some() {
         bail!(
             "--record writes the policy's evaluation over the paper's episode, not over \
              --episode-steps: drop one of the two"
         );
     }
-    setup.episode_steps = args.episode_steps.map(|steps| steps as usize);
+    setup.settings.episode_steps = args.episode_steps.map(|steps| steps as usize);
     for (flag, asked) in [
         ("--record-closest", args.record_closest.is_some()),
         ("--record-handovers", args.record_handovers.is_some()),

@@ -8,8 +8,8 @@ use std::sync::Arc;
 use anyhow::bail;
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    ControlRate, CubeRotEnv, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind, RotGoal, RotMode,
-    SimulatedEnv, StartMix,
+    ControlRate, CubeRotEnv, EpisodeSettings, Info, LayerGoal, LayerMove, LayerOpEnv, ObjectKind,
+    RotGoal, RotMode, SimulatedEnv, StartMix,
 };
 use dexcube_operator::eval::PolicyFiles;
 use dexcube_operator::stages::{PolicyStage1, PolicyStage2, trained_control_rate};
@@ -29,17 +29,14 @@ pub struct StageSetup {
     pub object: ObjectKind,
     pub trained_object: ObjectKind,
     pub scene: Arc<Scene>,
-    /// The rate the policy acts at, and the one it was trained at.
-    pub control_rate: ControlRate,
+    /// How the episodes run: at the rate the policy acts at, the paper's otherwise unless a
+    /// caller sets a physics spread (`eval-stage --physics-spread`) or an episode length
+    /// (`eval-stage --episode-steps`).
+    pub settings: EpisodeSettings,
+    /// The rate the policy was trained at.
     pub trained_rate: ControlRate,
     /// The paper's success test: position (Stage 1) and angle thresholds.
     pub thresholds: (f64, f64),
-    /// How far each episode's physics is varied (`train --physics-spread`); 0, the scene's
-    /// own, unless a caller sets it.
-    pub physics_spread: f64,
-    /// Control steps to an episode where set (`eval-stage --episode-steps`); `None`, the
-    /// rate's 4 simulated seconds, unless a caller sets it.
-    pub episode_steps: Option<usize>,
 }
 
 impl StageSetup {
@@ -73,11 +70,12 @@ impl StageSetup {
             object,
             trained_object,
             scene: Scene::load(object.scene())?,
-            control_rate: control_rate.unwrap_or(trained_rate),
+            settings: EpisodeSettings {
+                rate: control_rate.unwrap_or(trained_rate),
+                ..EpisodeSettings::PAPER
+            },
             trained_rate,
             thresholds,
-            physics_spread: 0.0,
-            episode_steps: None,
             prefix,
         })
     }
@@ -108,9 +106,7 @@ impl StageSetup {
                 let goal = PolicyStage1::trained_goal(policy, self.rot_mode, prefix)?;
                 let env = CubeRotEnv::with_scene(self.scene.clone(), goal)
                     .with_view(view)
-                    .with_control_rate(self.control_rate)
-                    .with_physics_spread(self.physics_spread)
-                    .with_episode_steps(self.episode_steps);
+                    .with_settings(self.settings);
                 Box::new(env.with_starts(starts))
             }
             EnvKind::Layer => {
@@ -121,9 +117,7 @@ impl StageSetup {
                 )
                 .with_goal(PolicyStage2::trained_goal(policy, prefix)?)
                 .with_view(view)
-                .with_control_rate(self.control_rate)
-                .with_physics_spread(self.physics_spread)
-                .with_episode_steps(self.episode_steps);
+                .with_settings(self.settings);
                 Box::new(env.with_starts(starts))
             }
         })

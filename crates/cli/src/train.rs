@@ -7,7 +7,9 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::{LayerGoals, LayerMove};
-use dexcube_env::{ControlRate, CubeRotEnv, GoalLead, LayerOpEnv, StartMix, StartPick};
+use dexcube_env::{
+    ControlRate, CubeRotEnv, EpisodeSettings, GoalLead, LayerOpEnv, StartMix, StartPick,
+};
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::handover::Handover;
 use dexcube_rl::start_gesture::StartGesture;
@@ -686,6 +688,11 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         }),
         None => None,
     };
+    let settings = EpisodeSettings {
+        rate,
+        physics_spread: args.physics_spread,
+        ..EpisodeSettings::PAPER
+    };
     let trained = match args.choice.env {
         EnvKind::Rot => {
             let goal = args.choice.rot_goal()?;
@@ -693,8 +700,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                 CubeRotEnv::with_scene(scene.clone(), goal)
                     .with_view(view)
                     .with_starts(starts.clone())
-                    .with_control_rate(rate)
-                    .with_physics_spread(args.physics_spread)
+                    .with_settings(settings)
             };
             train(make, config, &options)?
         }
@@ -710,8 +716,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_goal(goal)
                     .with_view(view)
                     .with_starts(starts.clone())
-                    .with_control_rate(rate)
-                    .with_physics_spread(args.physics_spread)
+                    .with_settings(settings)
             };
             train(make, config, &options)?
         }

@@ -165,8 +165,19 @@ pub struct HandObject {
     /// Where the object comes to rest on the palm, and CubeRotEnv's target position.
     pub resting: [f64; 3],
     pub steps: usize,
-    /// How often a policy acts: the paper's rate unless set. Placing and settling keep the
-    /// paper's, so every rate starts from the same placements.
+    pub settings: EpisodeSettings,
+}
+
+/// How either environment runs its episodes beyond the scene: the paper's
+/// ([`EpisodeSettings::PAPER`]) unless set ([`CubeRotEnv::with_settings`],
+/// [`LayerOpEnv::with_settings`]).
+///
+/// [`CubeRotEnv::with_settings`]: crate::CubeRotEnv::with_settings
+/// [`LayerOpEnv::with_settings`]: crate::LayerOpEnv::with_settings
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EpisodeSettings {
+    /// How often a policy acts. Placing and settling keep the paper's rate, so every rate
+    /// starts from the same placements.
     pub rate: ControlRate,
     /// The most an actuator's target may move in one control step, in action units (the
     /// action range is 2 wide); `None` (the paper's) lets it jump anywhere at once.
@@ -177,6 +188,28 @@ pub struct HandObject {
     /// Control steps in an episode where set; `None` (the paper's) is the rate's 4 simulated
     /// seconds ([`ControlRate::episode_steps`]).
     pub episode_steps: Option<usize>,
+}
+
+impl EpisodeSettings {
+    /// The paper's: its control rate, targets free to jump, the scene's own physics and
+    /// episodes of 4 simulated seconds.
+    pub const PAPER: EpisodeSettings = EpisodeSettings {
+        rate: ControlRate::PAPER,
+        action_slew: None,
+        physics_spread: 0.0,
+        episode_steps: None,
+    };
+
+    /// Control steps in an episode.
+    pub fn episode_length(&self) -> usize {
+        self.episode_steps.unwrap_or(self.rate.episode_steps())
+    }
+}
+
+impl Default for EpisodeSettings {
+    fn default() -> EpisodeSettings {
+        EpisodeSettings::PAPER
+    }
 }
 
 impl HandObject {
@@ -196,10 +229,7 @@ impl HandObject {
             rng: ChaCha8Rng::seed_from_u64(0),
             resting,
             steps: 0,
-            rate: ControlRate::PAPER,
-            action_slew: None,
-            physics_spread: 0.0,
-            episode_steps: None,
+            settings: EpisodeSettings::PAPER,
         }
     }
 
@@ -210,8 +240,8 @@ impl HandObject {
         if let Some(seed) = seed {
             self.rng = ChaCha8Rng::seed_from_u64(seed);
         }
-        if self.physics_spread > 0.0 {
-            let (spread, rng) = (self.physics_spread, &mut self.rng);
+        if self.settings.physics_spread > 0.0 {
+            let (spread, rng) = (self.settings.physics_spread, &mut self.rng);
             let mut scale = || (1.0 + spread).powf(rng.random_range(-1.0..=1.0));
             let scales = PhysicsScales {
                 friction: scale(),
@@ -260,7 +290,7 @@ impl HandObject {
                 0.0
             };
         }
-        if let Some(slew) = self.action_slew {
+        if let Some(slew) = self.settings.action_slew {
             for (c, held) in clipped.iter_mut().zip(self.sim.action()) {
                 *c = c.clamp(held - slew, held + slew);
             }
@@ -268,7 +298,7 @@ impl HandObject {
         self.sim.set_action(&clipped);
         self.steps += 1;
         self.sim
-            .step_substeps(self.rate.substeps())
+            .step_substeps(self.settings.rate.substeps())
             .err()
             .inspect(|_| self.sim.reset())
     }
@@ -296,7 +326,7 @@ impl HandObject {
         let reward = goal.compute_reward(&observation.achieved_goal, &observation.desired_goal);
         Transition {
             terminated: info.dropped || info.physics_error.is_some(),
-            truncated: self.steps >= self.episode_steps.unwrap_or(self.rate.episode_steps()),
+            truncated: self.steps >= self.settings.episode_length(),
             observation,
             reward,
             info,

@@ -44,9 +44,11 @@ use dexcube_sim::{Scene, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, LayerGoal, wrap_angle};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, ObjectKind, View, canonical};
+use crate::hand_object::{
+    BASE_OBSERVATION, EpisodeSettings, HandObject, ObjectKind, View, canonical,
+};
 use crate::starts::{RecordedStart, StartMix};
-use crate::{ControlRate, GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
+use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// Which layer faces where, and which way it turns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -397,30 +399,11 @@ impl LayerOpEnv {
         self
     }
 
-    /// The same environment with the policy acting at `rate` rather than the paper's.
-    pub fn with_control_rate(mut self, rate: ControlRate) -> LayerOpEnv {
-        self.hand.rate = rate;
-        self
-    }
-
-    /// The same environment with each episode's physics varied by `spread`
-    /// ([`HandObject::begin_episode`]; 0 keeps the scene's own, as the paper does).
-    pub fn with_physics_spread(mut self, spread: f64) -> LayerOpEnv {
-        self.hand.physics_spread = spread;
-        self
-    }
-
-    /// The same environment with `steps` control steps to an episode where given, rather
-    /// than the rate's 4 simulated seconds ([`HandObject::episode_steps`]).
-    pub fn with_episode_steps(mut self, steps: Option<usize>) -> LayerOpEnv {
-        self.hand.episode_steps = steps;
-        self
-    }
-
-    /// The same environment with each actuator's target moving at most `slew` action units
-    /// per control step ([`HandObject::action_slew`]).
-    pub fn with_action_slew(mut self, slew: Option<f64>) -> LayerOpEnv {
-        self.hand.action_slew = slew;
+    /// The same environment running its episodes as `settings` say rather than as the paper
+    /// does: another control rate, a limit on how fast the actuators' targets move, varied
+    /// physics, another episode length.
+    pub fn with_settings(mut self, settings: EpisodeSettings) -> LayerOpEnv {
+        self.hand.settings = settings;
         self
     }
 

@@ -34,7 +34,7 @@ use std::sync::Arc;
 pub use dexcube_sim::SimError;
 pub use goal::{Goal, GoalLead, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{
-    BASE_OBSERVATION, DROP_DEPTH, OBJECT_POSITION, ObjectKind, SETTLE_STEPS, View,
+    BASE_OBSERVATION, DROP_DEPTH, EpisodeSettings, OBJECT_POSITION, ObjectKind, SETTLE_STEPS, View,
     base_observation, is_dropped, is_square, resting_point, set_down,
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};

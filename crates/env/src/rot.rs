@@ -35,10 +35,12 @@ use dexcube_sim::{Scene, SceneKind, Sim, SimError};
 use rand::Rng;
 
 use crate::goal::{Goal, RotGoal, RotMode};
-use crate::hand_object::{BASE_OBSERVATION, HandObject, View, base_observation, canonical};
+use crate::hand_object::{
+    BASE_OBSERVATION, EpisodeSettings, HandObject, View, base_observation, canonical,
+};
 use crate::random::uniform_rotation;
 use crate::starts::{RecordedStart, StartMix};
-use crate::{ControlRate, GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
+use crate::{GoalEnv, Info, Observation, SimulatedEnv, Spaces, Transition};
 
 /// The paper's three Stage 1 targets, `[w, x, y, z]`.
 pub const PAPER_TARGETS: [Quat; 3] = [
@@ -145,23 +147,11 @@ impl CubeRotEnv {
         self
     }
 
-    /// The same environment with the policy acting at `rate` rather than the paper's.
-    pub fn with_control_rate(mut self, rate: ControlRate) -> CubeRotEnv {
-        self.hand.rate = rate;
-        self
-    }
-
-    /// The same environment with each episode's physics varied by `spread`
-    /// ([`HandObject::begin_episode`]; 0 keeps the scene's own, as the paper does).
-    pub fn with_physics_spread(mut self, spread: f64) -> CubeRotEnv {
-        self.hand.physics_spread = spread;
-        self
-    }
-
-    /// The same environment with `steps` control steps to an episode where given, rather
-    /// than the rate's 4 simulated seconds ([`HandObject::episode_steps`]).
-    pub fn with_episode_steps(mut self, steps: Option<usize>) -> CubeRotEnv {
-        self.hand.episode_steps = steps;
+    /// The same environment running its episodes as `settings` say rather than as the paper
+    /// does: another control rate, a limit on how fast the actuators' targets move, varied
+    /// physics, another episode length.
+    pub fn with_settings(mut self, settings: EpisodeSettings) -> CubeRotEnv {
+        self.hand.settings = settings;
         self
     }
 

@@ -3,9 +3,9 @@
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::rot::PAPER_TARGETS;
 use dexcube_env::{
-    ControlRate, CubeLayer, CubeRotEnv, Goal, GoalEnv, GoalLead, LayerGoal, LayerMove, LayerOpEnv,
-    OBJECT_POSITION, ObjectKind, RecordedStart, RotGoal, RotMode, SimulatedEnv, StartMix,
-    StartPick, VecEnv, View, pose_goal,
+    ControlRate, CubeLayer, CubeRotEnv, EpisodeSettings, Goal, GoalEnv, GoalLead, LayerGoal,
+    LayerMove, LayerOpEnv, OBJECT_POSITION, ObjectKind, RecordedStart, RotGoal, RotMode,
+    SimulatedEnv, StartMix, StartPick, VecEnv, View, pose_goal,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
@@ -815,7 +815,10 @@ fn a_faster_control_rate_keeps_the_episode_four_seconds_long() {
     let scene = Scene::load(dexcube_sim::SceneKind::Rot).unwrap();
     let run = |substeps: usize| {
         let mut env = CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper))
-            .with_control_rate(ControlRate::every(substeps).unwrap());
+            .with_settings(EpisodeSettings {
+                rate: ControlRate::every(substeps).unwrap(),
+                ..EpisodeSettings::PAPER
+            });
         let (first, _) = env.reset(Some(3));
         let began = env.sim().time();
         let mut steps = 0;
@@ -845,7 +848,10 @@ fn an_episode_set_longer_or_shorter_truncates_at_its_own_length() {
     let scene = Scene::load(dexcube_sim::SceneKind::Rot).unwrap();
     let run = |steps: Option<usize>| {
         let mut env = CubeRotEnv::with_scene(scene.clone(), RotGoal::paper(RotMode::Paper))
-            .with_episode_steps(steps);
+            .with_settings(EpisodeSettings {
+                episode_steps: steps,
+                ..EpisodeSettings::PAPER
+            });
         let (first, _) = env.reset(Some(3));
         (1..)
             .find_map(|step| {
@@ -876,7 +882,10 @@ fn a_slew_limit_moves_each_target_at_most_that_far_per_step() {
     let env = |slew| {
         let mut env =
             LayerOpEnv::with_scene(scene.clone(), LayerMove::UPrime, LayerGoals::Evaluation)
-                .with_action_slew(slew);
+                .with_settings(EpisodeSettings {
+                    action_slew: slew,
+                    ..EpisodeSettings::PAPER
+                });
         env.reset(Some(5));
         env
     };
@@ -912,7 +921,10 @@ fn varied_physics_draws_each_episodes_scales_from_its_seed() {
     let scales = |spread: f64, seed: u64| {
         let mut env =
             LayerOpEnv::with_scene(scene.clone(), LayerMove::UPrime, LayerGoals::Training)
-                .with_physics_spread(spread);
+                .with_settings(EpisodeSettings {
+                    physics_spread: spread,
+                    ..EpisodeSettings::PAPER
+                });
         env.reset(Some(seed));
         let (now, nominal) = (env.sim().data().model(), scene.model());
         let friction = (0..nominal.geom_friction().len())

@@ -6,7 +6,7 @@
 //! and after them.
 //!
 //! `--slew S` caps each actuator's target change per control step
-//! ([`LayerOpEnv::with_action_slew`]), to ask whether gentler fingers jam less. `--keep-jams
+//! ([`EpisodeSettings::action_slew`]), to ask whether gentler fingers jam less. `--keep-jams
 //! OUT` writes, for every jammed episode, the physics state at steps 10, 30 and 60 as Stage 2
 //! starts (the quarter turn asked for, counted from the angle the layer had turned, marked
 //! failed), so that a run can train from inside a jam (`dexcube train layer --starts OUT`).
@@ -21,7 +21,8 @@ use std::path::{Path, PathBuf};
 
 use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    GoalEnv, LayerMove, LayerOpEnv, RecordedFailure, RecordedStart, SimulatedEnv, is_square,
+    EpisodeSettings, GoalEnv, LayerMove, LayerOpEnv, RecordedFailure, RecordedStart, SimulatedEnv,
+    is_square,
 };
 use dexcube_operator::stages::PolicyStage2;
 use dexcube_rl::Policy;
@@ -127,7 +128,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )
     .with_goal(PolicyStage2::trained_goal(&policy, &args.policy)?)
     .with_view(PolicyStage2::trained_view(&policy, &args.policy)?)
-    .with_action_slew(args.slew);
+    .with_settings(EpisodeSettings {
+        action_slew: args.slew,
+        ..EpisodeSettings::PAPER
+    });
     let episodes = match &args.starts {
         Starts::Fresh { episodes, .. } => *episodes as usize,
         Starts::Failed(starts) => starts.len(),
