@@ -69,6 +69,21 @@ fn attempt_judged(
     )
 }
 
+/// The scramble at `distance` (`seed`) run by the kinematic stages, judged as `judged` says:
+/// solved, with no re-plan or randomisation on the way.
+fn solved_kinematically(judged: Judged, distance: usize, seed: u64) -> Outcome {
+    let outcome = attempt_judged(
+        judged,
+        &mut KinematicStage1,
+        &mut KinematicStage2 { angle: U_PRIME },
+        distance,
+        seed,
+    );
+    assert!(outcome.solved, "distance {distance}: {outcome:?}");
+    assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
+    outcome
+}
+
 /// The cube upright (U up) at `position`.
 fn level_at(position: [f64; 3]) -> Pose {
     Pose {
@@ -136,15 +151,7 @@ fn perfect_stages_solve_scrambles_with_the_expected_action_number() {
                 plan_from_face_up,
                 ..OperatorConfig::default()
             };
-            let outcome = attempt_judged(
-                (RotMode::Axis, config, None),
-                &mut KinematicStage1,
-                &mut KinematicStage2 { angle: U_PRIME },
-                distance,
-                seed,
-            );
-            assert!(outcome.solved, "distance {distance}: {outcome:?}");
-            assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
+            let outcome = solved_kinematically((RotMode::Axis, config, None), distance, seed);
             let expected: usize = if plan_for_hand {
                 let up_now = plan_from_face_up.then_some(Face::U);
                 let plan = table.cheapest_optimal(&position, hand_cost(up_now));
@@ -218,18 +225,8 @@ fn plans_of_any_length_cost_the_hand_what_the_table_says() {
         let position = dexcube_cube::Position::of(
             &scrambles_at_distance(&table, distance, 1, seed)[0].facelets,
         );
-        let run = |any_length| {
-            let outcome = attempt_judged(
-                (RotMode::Axis, config, any_length),
-                &mut KinematicStage1,
-                &mut KinematicStage2 { angle: U_PRIME },
-                distance,
-                seed,
-            );
-            assert!(outcome.solved, "distance {distance}: {outcome:?}");
-            assert_eq!((outcome.replans, outcome.randomisations), (0, 0));
-            outcome
-        };
+        let run =
+            |any_length| solved_kinematically((RotMode::Axis, config, any_length), distance, seed);
         let optimal = run(None);
         let cheapest = run(Some(&in_actions));
         let up = Some(Face::U.axis());
