@@ -403,6 +403,11 @@ pub struct StartGestureArgs {
     /// Control steps the gesture lasts before the policy first acts.
     #[arg(long, default_value_t = 5)]
     steps: usize,
+    /// An ensemble's member (0 is the first) that acts alone, before and after any handover,
+    /// in the episodes that make the gesture: a specialist for the fingertips' side. Without
+    /// it those episodes go on as the policy acts in every other.
+    #[arg(long, value_name = "M")]
+    member: Option<usize>,
     /// Where to write the result (PATH.safetensors and PATH.json).
     #[arg(long)]
     out: PathBuf,
@@ -416,9 +421,13 @@ pub fn start_gesture(args: StartGestureArgs) -> anyhow::Result<ExitCode> {
         action: args.action,
         steps: args.steps,
         below_y: resting[1],
+        member: args.member,
     };
+    let member = args
+        .member
+        .map_or(String::new(), |m| format!(" --member {m}"));
     let command = format!(
-        "dexcube start-gesture {} --actuators {} --action {} --steps {} --out {}",
+        "dexcube start-gesture {} --actuators {} --action {} --steps {}{member} --out {}",
         args.policy.display(),
         gesture.actuator_list(),
         gesture.action,

@@ -1739,6 +1739,91 @@ fn a_policy_led_on_runs_on_the_goal_led_on() {
     assert_clean_failure(&joined, 2, "shown its goal led on (by 0.5 within 0.5 rad)");
 }
 
+/// `start-gesture --member 1` on an ensemble of `layer` and another Stage 2, handing over with
+/// `--first 0 --member 0 --let-go 10`, acts episode for episode as the other policy with the
+/// same handover and gesture where the gesture is made, and as `layer` with them elsewhere
+/// (`models/layer-gesture`'s making, with a specialist for its gesture's episodes); a member
+/// the ensemble lacks is refused cleanly.
+fn a_specialist_acts_alone_where_the_gesture_is_made(
+    dir: &std::path::Path,
+    [rot, layer]: [&str; 2],
+) {
+    let other = models().join("layer-w512-19");
+    let other = other.to_str().unwrap();
+    let path = |name: &str| dir.join(name);
+    let joined = dexcube(
+        &[
+            "ensemble",
+            layer,
+            other,
+            "--out",
+            path("pair").to_str().unwrap(),
+        ],
+        "",
+    );
+    assert!(joined.status.success(), "{}", stderr(&joined));
+    let let_go = |from: &str, first: &[&str], name: &str| {
+        let args = [&[from][..], first, &["--member", "0", "--let-go", "10"]].concat();
+        handover_into(&args, &path(name), "letting go for 10 steps first")
+    };
+    let pair = path("pair");
+    let handing = [
+        let_go(pair.to_str().unwrap(), &["--first", "0"], "pair-letgo"),
+        let_go(layer, &[], "layer-letgo"),
+        let_go(other, &[], "other-letgo"),
+    ];
+    let gesture = |from: &str, member: &[&str], name: &str| {
+        let args = ["--actuators", "3,6,9,13", "--action", "-1", "--steps", "5"];
+        let out = path(name);
+        let flags = [
+            &["start-gesture", from][..],
+            &args,
+            member,
+            &["--out", out.to_str().unwrap()],
+        ];
+        (
+            dexcube(&flags.concat(), ""),
+            out.to_str().unwrap().to_string(),
+        )
+    };
+    let rows = |from: &str, member: &[&str], name: &str| {
+        let (o, policy) = gesture(from, member, name);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let args = [
+            "layer",
+            "--episodes",
+            "8",
+            "--threads",
+            "2",
+            "--seed",
+            "13000000",
+        ];
+        let policies = ["--rot-policy", rot, "--layer-policy", &policy];
+        let (text, printed) =
+            eval_stage_csv(&dir.join("episodes.csv"), &[&args[..], &policies].concat());
+        let rows: Vec<String> = text.lines().skip(1).map(str::to_string).collect();
+        (rows, printed)
+    };
+    let (mine, printed) = rows(&handing[0], &["--member", "1"], "specialist");
+    let (elsewhere, _) = rows(&handing[1], &[], "layer-gesture");
+    let (where_made, _) = rows(&handing[2], &[], "other-gesture");
+    let made = (0..8).filter(|&k| mine[k] != elsewhere[k]).count();
+    assert!(
+        printed.contains(&format!("began with the start gesture in {made} episodes"))
+            && (1..8).contains(&made),
+        "{printed}"
+    );
+    for k in 0..8 {
+        assert!(
+            mine[k] == elsewhere[k] || mine[k] == where_made[k],
+            "episode {k}: {}",
+            mine[k]
+        );
+    }
+    let (o, _) = gesture(&handing[0], &["--member", "2"], "no-member");
+    assert_clean_failure(&o, 2, "it has 2 member(s) (0 to 1), not a member 2");
+}
+
 /// `start-gesture` writes a policy whose card names the gesture and where the cube scene's
 /// resting point lies, and `eval-stage` counts the episodes that began with it; `distil`
 /// refuses it as a teacher, and a gesture the hand cannot make, an action past the actuators'
@@ -1788,6 +1873,7 @@ fn a_start_gesture_is_written_counted_and_refused_cleanly() {
     .concat();
     assert_clean_failure(&dexcube(&distil, ""), 2, "makes a start gesture");
     after_gesture_starts_are_where_the_policy_first_acts(&dir, [rot, layer, out]);
+    a_specialist_acts_alone_where_the_gesture_is_made(&dir, [rot, layer]);
     for (from, actuators, action, says) in [
         (layer, "3,20", "-1", "not an actuator 20"),
         (layer, "3", "1.5", "an action is between -1 and 1, not 1.5"),

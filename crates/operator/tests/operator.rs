@@ -936,6 +936,7 @@ fn a_start_gesture_comes_first_only_towards_the_fingertips() {
         action: -1.0,
         steps: 2,
         below_y: resting[1],
+        member: None,
     };
     let out = dir.join("layer-gesture");
     Policy::with_start_gesture(&shipped, gesture.clone(), &out, "test").unwrap();

@@ -509,6 +509,14 @@ impl Policy {
                 return Err(already.into());
             }
             gesture.check(card.dims)?;
+            let members = 1 + card.partners.len();
+            if let Some(member) = gesture.member.filter(|&m| m >= members) {
+                return Err(format!(
+                    "it has {members} member(s) (0 to {}), not a member {member} to act where \
+                     the gesture is made",
+                    members - 1
+                ));
+            }
             card.start_gesture = Some(gesture);
             Ok(())
         })
@@ -678,9 +686,19 @@ impl Acting<'_> {
                 return action.clone();
             }
         }
+        // A specialist member acts alone, before and after any handover, in the episodes
+        // that made the gesture.
+        let specialist = self
+            .gesture
+            .as_ref()
+            .and(policy.card.start_gesture.as_ref())
+            .and_then(|gesture| gesture.member);
         let lead = policy.card.goal_lead;
         if lead.is_none() && self.watch.is_none() {
-            return policy.act(observation, desired);
+            return match specialist {
+                Some(member) => policy.member_action(member, observation, desired),
+                None => policy.act(observation, desired),
+            };
         }
         let now = achieved();
         let shown = match lead {
@@ -693,15 +711,19 @@ impl Acting<'_> {
         match (turn, policy.card.handover) {
             (Turn::LettingGo, _) => vec![0.0; policy.card.dims.action],
             (Turn::Member, Some(handover)) => {
-                policy.member_action(handover.member, observation, &shown)
+                let member = specialist.unwrap_or(handover.member);
+                policy.member_action(member, observation, &shown)
             }
             (
                 Turn::Before,
                 Some(Handover {
                     first: Some(first), ..
                 }),
-            ) => policy.member_action(first, observation, &shown),
-            _ => policy.act(observation, &shown),
+            ) => policy.member_action(specialist.unwrap_or(first), observation, &shown),
+            _ => match specialist {
+                Some(member) => policy.member_action(member, observation, &shown),
+                None => policy.act(observation, &shown),
+            },
         }
     }
 

@@ -6,7 +6,8 @@
 //! elsewhere, mostly by the placement rather than by chance (session 37), and that the four
 //! fingers' knuckles held straight for the first few steps, before the policy acts, mend most
 //! of those failures. The gesture is decided by the policy's own view at the first step: the
-//! cube's position is part of every observation.
+//! cube's position is part of every observation. An ensemble's card may name a member to act
+//! alone in the episodes that make the gesture: a specialist for that side (session 55).
 
 use serde::{Deserialize, Serialize};
 
@@ -27,6 +28,11 @@ pub struct StartGesture {
     pub action: f64,
     pub steps: usize,
     pub below_y: f64,
+    /// The ensemble member that acts alone in the episodes that make the gesture, before and
+    /// after any handover (a specialist for the fingertips' side); none: those episodes go
+    /// on as the card says for every episode.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub member: Option<usize>,
 }
 
 /// What the gesture does, in words, for a policy's card and the command that makes it.
@@ -39,7 +45,11 @@ impl std::fmt::Display for StartGesture {
             self.action,
             self.steps,
             self.below_y
-        )
+        )?;
+        if let Some(member) = self.member {
+            write!(f, ", member {member} acting alone in those episodes")?;
+        }
+        Ok(())
     }
 }
 
@@ -104,6 +114,7 @@ mod tests {
             action: -1.0,
             steps: 5,
             below_y: 0.87,
+            member: None,
         }
     }
 
