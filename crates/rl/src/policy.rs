@@ -666,7 +666,8 @@ impl Acting<'_> {
     /// start gesture's for its first steps where the card has one and the cube started towards
     /// the fingertips; then shown the goal led on where the card says so, from the object's
     /// goal now, and by the member handed over to once the episode has stalled, where it says
-    /// so; `achieved` reads the object's goal only for these.
+    /// so, or throughout by the gesture's own member in an episode that made a gesture naming
+    /// one; `achieved` reads the object's goal only for these.
     pub fn act_toward(
         &mut self,
         observation: &[f64],
