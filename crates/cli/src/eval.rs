@@ -748,8 +748,8 @@ pub struct EvalStageArgs {
     /// With --record-starts and a policy with a start gesture (`dexcube start-gesture`):
     /// record an episode that makes the gesture where the policy first acts after it (the
     /// physics state after the gesture's last step, the goal, the angle the layer turned
-    /// meanwhile and the face whose layer turns), so that `train --starts` can teach the policy's actor, which makes no
-    /// gesture, from where the gesture leaves the cube. Such starts are for the actor alone:
+    /// meanwhile and the face whose layer turns), so that `train --starts` can teach the
+    /// policy's actor, which makes no gesture, from where the gesture leaves the cube. Such starts are for the actor alone:
     /// replayed with the gesturing policy, the gesture would be made twice.
     #[arg(long, requires = "record_starts")]
     after_gesture: bool,

@@ -206,12 +206,6 @@ impl EpisodeSettings {
     }
 }
 
-impl Default for EpisodeSettings {
-    fn default() -> EpisodeSettings {
-        EpisodeSettings::PAPER
-    }
-}
-
 impl HandObject {
     /// A hand with its object, and the object's resting point: where it settles from the
     /// scene's start with a neutral action.

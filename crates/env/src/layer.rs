@@ -194,9 +194,8 @@ impl CubeLayer {
     /// Follows the layer angle to `sim`'s state without building an observation, for a
     /// watcher that needs only the angle; it must be called as often as the policy observes,
     /// every control step, for the angle to unwrap the same way.
-    pub fn follow(&mut self, sim: &Sim) -> f64 {
+    pub fn follow(&mut self, sim: &Sim) {
         self.follow_reading(&read_cube(sim));
-        self.turned
     }
 
     /// Readings wrap at ±45°: accumulates the change since the last reading, brought into

@@ -529,8 +529,8 @@ impl Stage1 for RecordingStage1<'_> {
 /// angle the layer had already turned while the hand opened (the policy's view counts from
 /// the stage's start) and the face whose layer turns, and whether the run then failed by the
 /// square test ([`LayerGoal::square`]: the top layer turned within 0.1 rad of U', with the
-/// cube in its good state, and not dropped). A run that dropped the cube while the hand opened records
-/// nothing.
+/// cube in its good state, and not dropped). A run that dropped the cube while the hand
+/// opened records nothing.
 pub struct RecordingStage2<'a> {
     pub inner: &'a mut dyn Stage2,
     pub starts: &'a mut Vec<RecordedStart>,

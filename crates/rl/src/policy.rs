@@ -688,18 +688,19 @@ impl Acting<'_> {
             }
         }
         // A specialist member acts alone, before and after any handover, in the episodes
-        // that made the gesture.
+        // that made the gesture; otherwise the member the turn names, or all of them.
         let specialist = self
             .gesture
             .as_ref()
             .and(policy.card.start_gesture.as_ref())
             .and_then(|gesture| gesture.member);
+        let act = |member: Option<usize>, goal: &[f64]| match specialist.or(member) {
+            Some(member) => policy.member_action(member, observation, goal),
+            None => policy.act(observation, goal),
+        };
         let lead = policy.card.goal_lead;
         if lead.is_none() && self.watch.is_none() {
-            return match specialist {
-                Some(member) => policy.member_action(member, observation, desired),
-                None => policy.act(observation, desired),
-            };
+            return act(None, desired);
         }
         let now = achieved();
         let shown = match lead {
@@ -711,20 +712,9 @@ impl Acting<'_> {
         });
         match (turn, policy.card.handover) {
             (Turn::LettingGo, _) => vec![0.0; policy.card.dims.action],
-            (Turn::Member, Some(handover)) => {
-                let member = specialist.unwrap_or(handover.member);
-                policy.member_action(member, observation, &shown)
-            }
-            (
-                Turn::Before,
-                Some(Handover {
-                    first: Some(first), ..
-                }),
-            ) => policy.member_action(specialist.unwrap_or(first), observation, &shown),
-            _ => match specialist {
-                Some(member) => policy.member_action(member, observation, &shown),
-                None => policy.act(observation, &shown),
-            },
+            (Turn::Member, Some(handover)) => act(Some(handover.member), &shown),
+            (Turn::Before, Some(handover)) => act(handover.first, &shown),
+            _ => act(None, &shown),
         }
     }
 
