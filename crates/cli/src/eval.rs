@@ -749,8 +749,9 @@ pub struct EvalStageArgs {
     /// record an episode that makes the gesture where the policy first acts after it (the
     /// physics state after the gesture's last step, the goal, the angle the layer turned
     /// meanwhile and the face whose layer turns), so that `train --starts` can teach the
-    /// policy's actor, which makes no gesture, from where the gesture leaves the cube. Such starts are for the actor alone:
-    /// replayed with the gesturing policy, the gesture would be made twice.
+    /// policy's actor, which makes no gesture, from where the gesture leaves the cube. Such
+    /// starts are for the actor alone: replayed with the gesturing policy, the gesture would
+    /// be made twice.
     #[arg(long, requires = "record_starts")]
     after_gesture: bool,
     /// Stage 1 only: also record, for every episode that missed its pose and kept the cube,

@@ -177,7 +177,7 @@ pub(crate) fn read_single(
         format!(
             "it is an ensemble already, an ensemble of {} policies, and cannot be {used}: use \
              one of its members (its card's metadata.ensemble names them)",
-            card.partners.len() + 1
+            card.members()
         ),
     ))
 }
@@ -186,6 +186,11 @@ impl PolicyCard {
     /// The card of the policy at `prefix`, without its weights.
     pub fn read(prefix: &Path) -> Result<PolicyCard, CheckpointError> {
         checkpoint::load_json(&policy_file(prefix, "json"))
+    }
+
+    /// How many actors act together: 1, or an ensemble's members.
+    pub fn members(&self) -> usize {
+        1 + self.partners.len()
     }
 
     /// What on the card, besides the weights, decides how the policy acts: its guide's
@@ -463,7 +468,7 @@ impl Policy {
             }
             // Letting go, a policy may hand the episode to itself: it tries again.
             let letting_go = handover.let_go.is_some();
-            let members = 1 + card.partners.len();
+            let members = card.members();
             if members == 1 && !letting_go {
                 return Err(
                     "it is a single policy, with no member to hand over to: make an ensemble \
@@ -509,7 +514,7 @@ impl Policy {
                 return Err(already.into());
             }
             gesture.check(card.dims)?;
-            let members = 1 + card.partners.len();
+            let members = card.members();
             if let Some(member) = gesture.member.filter(|&m| m >= members) {
                 return Err(format!(
                     "it has {members} member(s) (0 to {}), not a member {member} to act where \
@@ -595,7 +600,7 @@ impl Policy {
 
     /// How many actors act together: 1, or an ensemble's members.
     pub fn members(&self) -> usize {
-        1 + self.partners.len()
+        self.card.members()
     }
 
     /// The policy acting through one episode, as its card says: shown its goal led on, and

@@ -11,6 +11,6 @@ if [ "$SNAP" != "-" ] && [ ! -f runs/s55/cards/$NAME.json ]; then
   $B start-gesture runs/s55/cards/$NAME-lg --actuators 3,6,9,13 --action -1 --steps 5 --out runs/s55/cards/$NAME > /dev/null
 fi
 P=runs/s55/cards/$NAME; [ "$SNAP" = "-" ] && P=models/layer-gesture
-N=$(python3 -c "import json,struct,sys;f=open('$STARTS','rb');n=struct.unpack('<Q',f.read(8))[0];h=json.loads(f.read(n));print(max(v['shape'][0] for k,v in h.items() if k!='__metadata__'))")
-$B eval-stage layer --object cube --episodes $N --threads $T --layer-policy $P --starts $STARTS --episodes-csv runs/s55/screen$TAG/$NAME.csv > runs/s55/screen$TAG/$NAME.txt 2>&1
+# --starts runs the first min(--episodes, starts) of them: every start.
+$B eval-stage layer --object cube --episodes 100000 --threads $T --layer-policy $P --starts $STARTS --episodes-csv runs/s55/screen$TAG/$NAME.csv > runs/s55/screen$TAG/$NAME.txt 2>&1
 head -1 runs/s55/screen$TAG/$NAME.txt
