@@ -1,4 +1,4 @@
-"""Writes the rows of a recorded run that belong to a subset of its recorded starts, numbered as a replay of the subset numbers them.
+"""Writes a recorded run's rows for a subset of its recorded starts, numbered as a replay of the subset numbers them.
 
 Usage: python3 results/starts/rows_of_starts.py RUN.csv RUN.safetensors SUBSET.safetensors OUT.csv
 
@@ -7,10 +7,19 @@ run; SUBSET.safetensors holds some of its starts in their order (for example `st
 Each subset start is found in the recording by its physics state and goal, and the run's row for it is written with
 `episode` and `seed` set to the subset's index, as `eval-stage --starts SUBSET` numbers its rows, so the output pairs
 with a replay by `results/goal-lead/pair_episodes.py` without replaying the recorded policy (session 57). It checks
-that the recording's failure marks agree with the rows (failed: not a success, or not left square), and exits with 2 naming the first start it cannot find.
+each row against its start's failure mark, read as the recording's metadata names it (`drops_by_start.origin`), and
+exits with 2 naming the first start it cannot find or whose mark disagrees.
 """
 import csv, os, sys
-from drops_by_start import load
+from drops_by_start import load, origin
+
+# Whether a row failed, for each failure mark a recording names (`RecordedFailure` in crates/env).
+FAILED = {
+    'dropped': lambda row: row['ending'] == 'dropped',
+    'dropped-or-missed': lambda row: row['ending'] != 'success',
+    # Stage 2: a success at the last step may still have left a cubelet out of square.
+    'not-square': lambda row: row['ending'] != 'success' or row['square'] == 'false',
+}
 
 
 def main(run_csv, run_starts, subset_starts, out_path):
@@ -20,6 +29,9 @@ def main(run_csv, run_starts, subset_starts, out_path):
         rows = list(csv.DictReader(f))
     if len(rows) != len(run['state']):
         sys.exit(f"{run_csv} has {len(rows)} rows but {run_starts} {len(run['state'])} starts: they are not one run")
+    mark = origin(run)['failure']
+    if mark not in FAILED:
+        sys.exit(f"{run_starts} marks failures as '{mark}', which this script does not read")
     index = {(tuple(s), tuple(g)): i for i, (s, g) in enumerate(zip(run['state'], run['goal']))}
     picked = []
     for k, key in enumerate(zip(map(tuple, subset['state']), map(tuple, subset['goal']))):
@@ -27,11 +39,8 @@ def main(run_csv, run_starts, subset_starts, out_path):
         if i is None:
             print(f"start {k} of {subset_starts} is not in {run_starts}", file=sys.stderr)
             sys.exit(2)
-        # A Stage 2 start is marked failed unless the layer turned with the cube square; a
-        # success at the last step may still have left a cubelet out of square.
-        failed = rows[i]['ending'] != 'success' or rows[i].get('square') == 'false'
-        if failed != bool(subset['failed'][k]):
-            print(f"start {k}: the row says {rows[i]['ending']} but the start is marked otherwise", file=sys.stderr)
+        if FAILED[mark](rows[i]) != bool(subset['failed'][k]):
+            print(f"start {k}: its row ({rows[i]['ending']}) disagrees with its '{mark}' mark", file=sys.stderr)
             sys.exit(2)
         picked.append(dict(rows[i], episode=str(k), seed=str(k)))
     tmp = out_path + '.tmp'
