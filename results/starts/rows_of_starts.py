@@ -7,15 +7,18 @@ run; SUBSET.safetensors holds some of its starts in their order (for example `st
 Each subset start is found in the recording by its physics state and goal, and the run's row for it is written with
 `episode` and `seed` set to the subset's index, as `eval-stage --starts SUBSET` numbers its rows, so the output pairs
 with a replay by `results/goal-lead/pair_episodes.py` without replaying the recorded policy (session 57). It checks
-each row against its start's failure mark, read as the recording's metadata names it (`drops_by_start.origin`), and
-exits with 2 naming the first start it cannot find or whose mark disagrees.
+each row against its start's failure mark, read as the recording's metadata names it (`drops_by_start.origin`).
+Whatever it cannot pair (not one run, a mark it does not read, a start not found, a mark that disagrees) it refuses
+with exit code 2 (`merge_starts.refuse`).
 """
 import csv, os, sys
 from drops_by_start import load, origin
+from merge_starts import refuse
+from pair_failures import marks
 
-# Whether a row failed, for each failure mark a recording names (`RecordedFailure` in crates/env).
+# Whether a row failed, for each failure mark an `eval-stage --record-starts` run writes (`RecordedFailure` in
+# crates/env; the `dropped` mark of sessions 13 to 19 came from operator runs, which have no episodes CSV).
 FAILED = {
-    'dropped': lambda row: row['ending'] == 'dropped',
     'dropped-or-missed': lambda row: row['ending'] != 'success',
     # Stage 2: a success at the last step may still have left a cubelet out of square.
     'not-square': lambda row: row['ending'] != 'success' or row['square'] == 'false',
@@ -28,20 +31,19 @@ def main(run_csv, run_starts, subset_starts, out_path):
     with open(run_csv) as f:
         rows = list(csv.DictReader(f))
     if len(rows) != len(run['state']):
-        sys.exit(f"{run_csv} has {len(rows)} rows but {run_starts} {len(run['state'])} starts: they are not one run")
+        refuse(f"{run_csv} has {len(rows)} rows but {run_starts} {len(run['state'])} starts: they are not one run")
     mark = origin(run)['failure']
     if mark not in FAILED:
-        sys.exit(f"{run_starts} marks failures as '{mark}', which this script does not read")
+        refuse(f"{run_starts} marks failures as '{mark}', which this script does not read")
     index = {(tuple(s), tuple(g)): i for i, (s, g) in enumerate(zip(run['state'], run['goal']))}
     picked = []
-    for k, key in enumerate(zip(map(tuple, subset['state']), map(tuple, subset['goal']))):
+    keys = zip(map(tuple, subset['state']), map(tuple, subset['goal']))
+    for k, (key, failed) in enumerate(zip(keys, marks(subset))):
         i = index.get(key)
         if i is None:
-            print(f"start {k} of {subset_starts} is not in {run_starts}", file=sys.stderr)
-            sys.exit(2)
-        if FAILED[mark](rows[i]) != bool(subset['failed'][k]):
-            print(f"start {k}: its row ({rows[i]['ending']}) disagrees with its '{mark}' mark", file=sys.stderr)
-            sys.exit(2)
+            refuse(f"start {k} of {subset_starts} is not in {run_starts}")
+        if FAILED[mark](rows[i]) != failed:
+            refuse(f"start {k}: its row ({rows[i]['ending']}) disagrees with its '{mark}' mark")
         picked.append(dict(rows[i], episode=str(k), seed=str(k)))
     tmp = out_path + '.tmp'
     with open(tmp, 'w', newline='') as f:
