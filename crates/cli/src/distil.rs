@@ -122,6 +122,14 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
             setup.prefix.display()
         );
     }
+    if teacher.card.start_route.is_some() {
+        bail!(
+            "{} hands the episodes that start towards the thumb to one member, which a student \
+             labelled step by step cannot learn from its actions: distil the ensemble it was \
+             made from (its card's metadata.start_route names it)",
+            setup.prefix.display()
+        );
+    }
     if teacher.card.start_gesture.is_some() {
         bail!(
             "{} makes a start gesture before it first acts, which a student labelled step by \

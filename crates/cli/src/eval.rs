@@ -909,6 +909,8 @@ struct EpisodeTrace {
     handed_over: bool,
     /// A policy with a start gesture made it before it first acted.
     gestured: bool,
+    /// A policy with a start route handed the episode to its member.
+    routed: bool,
 }
 
 /// What an episode keeps of its physics, for `--record-starts` (where the policy first acts
@@ -993,6 +995,7 @@ fn episode(
                 handover,
                 handed_over: acting.handed_over(),
                 gestured: acting.gestured(),
+                routed: acting.routed(),
             };
         }
         obs = t.observation;
@@ -1014,6 +1017,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let (handovers, successes_handed_over) = (AtomicUsize::new(0), AtomicUsize::new(0));
     // Episodes that began with a start gesture, and of them successes.
     let (gestures, successes_gestured) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    // Episodes a start route took to its member, and of them successes.
+    let (routes, successes_routed) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
     let (thresholds, control_rate) = (setup.thresholds, setup.settings.rate);
     if args.record && args.physics_spread > 0.0 {
@@ -1052,7 +1057,8 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     }
     let (prefix, object, scene) = (setup.prefix.clone(), setup.object, setup.scene.clone());
     let card = PolicyCard::read(&prefix)?;
-    let (handover, start_gesture) = (card.handover, card.start_gesture);
+    let (handover, start_gesture, start_route) =
+        (card.handover, card.start_gesture, card.start_route);
     if args.record_handovers.is_some() && handover.is_none() {
         bail!(
             "--record-handovers keeps where an ensemble hands an episode to its member, and {} \
@@ -1175,6 +1181,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             for (happened, count, successes) in [
                 (trace.handed_over, &handovers, &successes_handed_over),
                 (trace.gestured, &gestures, &successes_gestured),
+                (trace.routed, &routes, &successes_routed),
             ] {
                 if happened {
                     count.fetch_add(1, Ordering::Relaxed);
@@ -1307,6 +1314,14 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
             "  began with the start gesture in {} episodes ({} of them successes)",
             gestures.into_inner(),
             successes_gestured.into_inner()
+        );
+    }
+    if let Some(route) = start_route {
+        println!(
+            "  routed to member {} in {} episodes ({} of them successes)",
+            route.member,
+            routes.into_inner(),
+            successes_routed.into_inner()
         );
     }
     for (count, steps) in held.iter().zip(HOLDS) {

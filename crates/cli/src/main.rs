@@ -64,6 +64,11 @@ enum Command {
     /// the knuckles straightened first). Writes a policy that loads and runs as any other; its
     /// weights are unchanged.
     StartGesture(train::StartGestureArgs),
+    /// Lets an ensemble hand the episodes whose cube starts towards the thumb (and that make
+    /// no start gesture) to one member, acting alone throughout: a specialist for that quarter
+    /// of the palm. Writes a policy that loads and runs as any other; its weights are
+    /// unchanged.
+    StartRoute(train::StartRouteArgs),
     /// Teaches one actor to act as a stage policy does (an ensemble, typically) by DAgger:
     /// the teacher labels every state of episodes run first by itself, then by the student.
     Distil(distil::DistilArgs),
@@ -100,6 +105,7 @@ fn main() -> ExitCode {
         Command::GoalLead(args) => train::goal_lead(args),
         Command::Handover(args) => train::handover(args),
         Command::StartGesture(args) => train::start_gesture(args),
+        Command::StartRoute(args) => train::start_route(args),
         Command::Distil(args) => distil::run(args),
         Command::Eval(args) => eval::eval(args),
         Command::EvalStage(args) => eval::eval_stage(args),

@@ -13,6 +13,7 @@ use dexcube_env::{
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::handover::Handover;
 use dexcube_rl::start_gesture::StartGesture;
+use dexcube_rl::start_route::StartRoute;
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
@@ -437,6 +438,42 @@ pub fn start_gesture(args: StartGestureArgs) -> anyhow::Result<ExitCode> {
     Policy::with_start_gesture(&args.policy, gesture.clone(), &args.out, &command)?;
     println!(
         "{} making a start gesture, {gesture}, into {}",
+        args.policy.display(),
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct StartRouteArgs {
+    /// The ensemble (handing over, making a start gesture or not), as the path of its
+    /// .safetensors and .json less the extension.
+    policy: PathBuf,
+    /// The member (0 is the first) that acts alone, before and after any handover, in the
+    /// episodes whose cube starts towards the thumb and that make no start gesture.
+    #[arg(long, value_name = "M")]
+    member: usize,
+    /// Where to write the result (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn start_route(args: StartRouteArgs) -> anyhow::Result<ExitCode> {
+    // The thumb's side is told from where the physical cube comes to rest on the palm.
+    let resting = dexcube_operator::eval::resting_point()?;
+    let route = StartRoute {
+        below_x: resting[0],
+        member: args.member,
+    };
+    let command = format!(
+        "dexcube start-route {} --member {} --out {}",
+        args.policy.display(),
+        route.member,
+        args.out.display()
+    );
+    Policy::with_start_route(&args.policy, route, &args.out, &command)?;
+    println!(
+        "{} routing by its start, {route}, into {}",
         args.policy.display(),
         args.out.display()
     );

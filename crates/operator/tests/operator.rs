@@ -19,6 +19,7 @@ use dexcube_operator::{
 };
 use dexcube_rl::Policy;
 use dexcube_rl::start_gesture::StartGesture;
+use dexcube_rl::start_route::StartRoute;
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, snap_layers};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{Pose, Scene, SceneKind, Sim};
@@ -984,5 +985,87 @@ fn a_start_gesture_comes_first_only_towards_the_fingertips() {
     assert!(refused(lacking).contains("not an actuator 20"));
     let joined = Policy::ensemble(&[out.clone(), shipped.clone()], &dir.join("x"), "test");
     assert!(refused(joined).contains("makes a start gesture"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An ensemble with a start route hands the episodes whose cube starts towards the thumb to
+/// its member, acting alone from the first step, unless the episode makes the start gesture
+/// (which comes first, as the card says). Every other episode acts as the ensemble does. A
+/// second route, a single policy and a member it lacks are refused.
+#[test]
+fn a_start_route_hands_the_thumbs_side_to_its_member() {
+    let (stages, resting) = shipped_stages();
+    let device = burn::prelude::Device::flex();
+    let dir = std::env::temp_dir().join(format!("dexcube-start-route-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let (shipped, wide) = (models.join("layer"), models.join("layer-w512-19"));
+    let joined = dir.join("joined");
+    Policy::ensemble(&[shipped.clone(), wide.clone()], &joined, "test").unwrap();
+    let route = StartRoute {
+        below_x: resting[0],
+        member: 1,
+    };
+    let routed = dir.join("routed");
+    Policy::with_start_route(&joined, route, &routed, "test").unwrap();
+    let gesture = StartGesture {
+        actuators: vec![3, 6, 9, 13],
+        action: -1.0,
+        steps: 2,
+        below_y: resting[1],
+        member: None,
+    };
+    let out = dir.join("routed-gesture");
+    Policy::with_start_gesture(&routed, gesture.clone(), &out, "test").unwrap();
+    let policy = Policy::load(&out, &device).unwrap();
+    assert_eq!(policy.card.start_route, Some(route));
+    let (ensemble, member) = (
+        Policy::load(&joined, &device).unwrap(),
+        Policy::load(&wide, &device).unwrap(),
+    );
+    let mut env = LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
+        .unwrap()
+        .with_goal(stages.stage2.goal)
+        .with_view(stages.stage2.view);
+    let test = env.goal();
+    // Towards the fingertips or not, towards the thumb or not.
+    let mut quarters_seen = [false; 4];
+    for seed in 0..400 {
+        let (mut obs, _) = env.reset(Some(seed));
+        let position = &obs.observation[OBJECT_POSITION..OBJECT_POSITION + 2];
+        let (towards_tips, towards_thumb) = (position[1] < resting[1], position[0] < resting[0]);
+        let quarter = 2 * usize::from(towards_tips) + usize::from(towards_thumb);
+        if std::mem::replace(&mut quarters_seen[quarter], true) {
+            continue;
+        }
+        let mut acting = policy.episode();
+        for step in 1..=4 {
+            let achieved = || obs.achieved_goal.clone();
+            let action =
+                acting.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
+            let expected = match (towards_tips, towards_thumb) {
+                (true, _) if step <= 2 => gesture.action(20),
+                (false, true) => member.act(&obs.observation, &obs.desired_goal),
+                _ => ensemble.act(&obs.observation, &obs.desired_goal),
+            };
+            assert_eq!(action, expected, "seed {seed}, step {step}");
+            assert_eq!(acting.routed(), !towards_tips && towards_thumb);
+            obs = env.step(&action).observation;
+        }
+        if quarters_seen == [true; 4] {
+            break;
+        }
+    }
+    assert_eq!(quarters_seen, [true; 4], "starts in every quarter");
+    let refused = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
+        result.err().unwrap().to_string()
+    };
+    let again = Policy::with_start_route(&routed, route, &dir.join("x"), "test");
+    assert!(refused(again).contains("routes by the start already"));
+    let single = Policy::with_start_route(&shipped, route, &dir.join("x"), "test");
+    assert!(refused(single).contains("single policy"));
+    let lacking = StartRoute { member: 2, ..route };
+    let lacking = Policy::with_start_route(&joined, lacking, &dir.join("x"), "test");
+    assert!(refused(lacking).contains("not a member 2"));
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -17,6 +17,8 @@
 //!   and trying again;
 //! - [`start_gesture`]: a gesture the hand makes before a policy first acts, where the cube
 //!   starts towards the fingertips;
+//! - [`start_route`]: an ensemble member that acts alone where the cube starts towards the
+//!   thumb;
 //! - [`distil`]: one actor fitted to act as another policy (an ensemble) does, by DAgger;
 //! - [`point_mass`]: a small reaching task that proves the learner in seconds.
 //!
@@ -40,6 +42,7 @@ pub mod rollout;
 pub mod seeds;
 pub mod start_file;
 pub mod start_gesture;
+pub mod start_route;
 pub mod train;
 
 pub use agent::{Agent, Dims, Learners, SavedAnchor};

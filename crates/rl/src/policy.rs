@@ -26,6 +26,7 @@ use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
 use crate::params::{self, NamedTensor};
 use crate::start_gesture::StartGesture;
+use crate::start_route::StartRoute;
 
 /// Everything about a policy but its weights.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -53,6 +54,10 @@ pub struct PolicyCard {
     /// the fingertips; none for the paper's, which acts from the first step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub start_gesture: Option<StartGesture>,
+    /// A member that acts alone where the cube starts towards the thumb and no gesture is
+    /// made; none for the paper's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_route: Option<StartRoute>,
 }
 
 /// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
@@ -195,7 +200,7 @@ impl PolicyCard {
 
     /// What on the card, besides the weights, decides how the policy acts: its guide's
     /// settings (how many candidates, how far, drawn from which seed), its goal lead, its
-    /// handover and its start gesture.
+    /// handover, its start gesture and its start route.
     /// None for a policy that acts on its weights alone.
     pub fn acting_settings(&self) -> Option<serde_json::Value> {
         let mut settings = serde_json::Map::new();
@@ -217,6 +222,9 @@ impl PolicyCard {
         }
         if let Some(gesture) = &self.start_gesture {
             settings.insert("start_gesture".into(), serde_json::json!(gesture));
+        }
+        if let Some(route) = &self.start_route {
+            settings.insert("start_route".into(), serde_json::json!(route));
         }
         (!settings.is_empty()).then_some(serde_json::Value::Object(settings))
     }
@@ -255,6 +263,7 @@ impl Policy {
             goal_lead: None,
             handover: None,
             start_gesture: None,
+            start_route: None,
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -527,6 +536,29 @@ impl Policy {
         })
     }
 
+    /// Writes at `out` the ensemble at `policy` (with any of the settings above) routing the
+    /// episodes that start towards the thumb, and make no gesture, to one member as `route`
+    /// says ([`StartRoute`]); its weights are unchanged. The card records the policy and
+    /// `command`, the command that made it.
+    pub fn with_start_route(
+        policy: &Path,
+        route: StartRoute,
+        out: &Path,
+        command: &str,
+    ) -> Result<(), CheckpointError> {
+        let how = route.to_string();
+        restated(policy, (out, command), ("start_route", how), |card| {
+            if card.start_route.is_some() {
+                let already =
+                    "it routes by the start already: start from the policy it was made from";
+                return Err(already.into());
+            }
+            route.check(card.dims, card.members())?;
+            card.start_route = Some(route);
+            Ok(())
+        })
+    }
+
     /// Loads the policy at `prefix` onto `device`.
     pub fn load(prefix: &Path, device: &Device) -> Result<Policy, CheckpointError> {
         let (weights, card, tensors) = read_stored(prefix)?;
@@ -576,6 +608,7 @@ impl Policy {
                 goal_lead: None,
                 handover: None,
                 start_gesture: None,
+                start_route: None,
                 ..self.card.clone()
             },
             actor,
@@ -611,6 +644,7 @@ impl Policy {
             watch: self.card.handover.map(HandoverWatch::new),
             steps: 0,
             gesture: None,
+            routed: None,
         }
     }
 
@@ -664,6 +698,9 @@ pub struct Acting<'a> {
     /// The start gesture's action, where this episode makes it (decided at the first step; it
     /// lasts the card's `start_gesture.steps`).
     gesture: Option<Vec<f64>>,
+    /// Whether the card's start route applies to this episode (decided at the first step,
+    /// after the gesture; none before it).
+    routed: Option<bool>,
 }
 
 impl Acting<'_> {
@@ -693,12 +730,18 @@ impl Acting<'_> {
             }
         }
         // A specialist member acts alone, before and after any handover, in the episodes
-        // that made the gesture; otherwise the member the turn names, or all of them.
-        let specialist = self
-            .gesture
-            .as_ref()
-            .and(policy.card.start_gesture.as_ref())
-            .and_then(|gesture| gesture.member);
+        // that made the gesture or that the start route takes; otherwise the member the turn
+        // names, or all of them.
+        let gestured = self.gesture.is_some();
+        let route = policy.card.start_route;
+        let routed = *self.routed.get_or_insert_with(|| {
+            !gestured && route.is_some_and(|route| route.applies(observation))
+        });
+        let specialist = match (gestured, routed) {
+            (true, _) => policy.card.start_gesture.as_ref().and_then(|g| g.member),
+            (false, true) => route.map(|route| route.member),
+            (false, false) => None,
+        };
         let act = |member: Option<usize>, goal: &[f64]| match specialist.or(member) {
             Some(member) => policy.member_action(member, observation, goal),
             None => policy.act(observation, goal),
@@ -721,6 +764,11 @@ impl Acting<'_> {
             (Turn::Before, Some(handover)) => act(handover.first, &shown),
             _ => act(None, &shown),
         }
+    }
+
+    /// Whether the card's start route took the episode to its member.
+    pub fn routed(&self) -> bool {
+        self.routed == Some(true)
     }
 
     /// Whether the episode began with the start gesture.
