@@ -10,9 +10,9 @@ set -e
 B=${B:-.dev/d56/dexcube}
 $B ensemble --out $1-ens $2 $3 $4 > /dev/null
 $B handover $1-ens --first 0 --member 0 --let-go 10 --out $1-lg > /dev/null
-if [ -z "$4" ]; then
-  $B start-gesture $1-lg --actuators 3,6,9,13 --action -1 --steps 5 --member 1 --out $1 > /dev/null
-else
-  $B start-gesture $1-lg --actuators 3,6,9,13 --action -1 --steps 5 --member 1 --out $1-gs > /dev/null
-  $B start-route $1-gs --member 2 --out $1 > /dev/null
+# Without MEMBER2 the gesture's card is the last; with it, the route is made on top of it.
+GESTURE=$1${4:+-gs}
+$B start-gesture $1-lg --actuators 3,6,9,13 --action -1 --steps 5 --member 1 --out $GESTURE > /dev/null
+if [ -n "$4" ]; then
+  $B start-route $GESTURE --member 2 --out $1 > /dev/null
 fi

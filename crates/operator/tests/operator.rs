@@ -920,6 +920,53 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     assert!(card_rate(&stages).is_err());
 }
 
+/// The four fingers' knuckles held straight for 2 steps where the cube starts with y below
+/// `below_y`, with no member of its own.
+fn knuckles(below_y: f64) -> StartGesture {
+    StartGesture {
+        actuators: vec![3, 6, 9, 13],
+        action: -1.0,
+        steps: 2,
+        below_y,
+        member: None,
+    }
+}
+
+/// The shipped Stage 2's environment: U' on the cube, with its goal and view.
+fn shipped_layer_env(stages: &dexcube_operator::eval::LoadedStages) -> LayerOpEnv {
+    LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
+        .unwrap()
+        .with_goal(stages.stage2.goal)
+        .with_view(stages.stage2.view)
+}
+
+/// Acts the first 4 control steps of the episode `env` began at `seed` (its first observation
+/// `obs`) with `policy`, asserting each action is `expected(step, observation)` and calling
+/// `check` on the acting policy after each.
+fn assert_first_actions(
+    policy: &Policy,
+    env: &mut LayerOpEnv,
+    (seed, mut obs): (u64, dexcube_env::Observation),
+    expected: impl Fn(usize, &dexcube_env::Observation) -> Vec<f64>,
+    check: impl Fn(&dexcube_rl::policy::Acting),
+) {
+    let test = env.goal();
+    let mut acting = policy.episode();
+    for step in 1..=4 {
+        let achieved = || obs.achieved_goal.clone();
+        let action =
+            acting.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
+        assert_eq!(action, expected(step, &obs), "seed {seed}, step {step}");
+        check(&acting);
+        obs = env.step(&action).observation;
+    }
+}
+
+/// What a policy's making refused with.
+fn refusal(result: Result<(), dexcube_rl::checkpoint::CheckpointError>) -> String {
+    result.err().unwrap().to_string()
+}
+
 /// A policy made from the shipped Stage 2 with a start gesture makes it for its first steps
 /// where the cube starts towards the fingertips, then acts as the shipped one; where the cube
 /// starts elsewhere it acts as the shipped one from the first step. A second gesture, and an
@@ -932,59 +979,43 @@ fn a_start_gesture_comes_first_only_towards_the_fingertips() {
     let dir = std::env::temp_dir().join(format!("dexcube-start-gesture-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/layer");
-    let gesture = StartGesture {
-        actuators: vec![3, 6, 9, 13],
-        action: -1.0,
-        steps: 2,
-        below_y: resting[1],
-        member: None,
-    };
+    let gesture = knuckles(resting[1]);
     let out = dir.join("layer-gesture");
     Policy::with_start_gesture(&shipped, gesture.clone(), &out, "test").unwrap();
     let gesturing = Policy::load(&out, &device).unwrap();
     assert_eq!(gesturing.card.start_gesture.as_ref(), Some(&gesture));
     let plain = &stages.stage2.policy;
-    let mut env = LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
-        .unwrap()
-        .with_goal(stages.stage2.goal)
-        .with_view(stages.stage2.view);
-    let test = env.goal();
+    let mut env = shipped_layer_env(&stages);
     let mut sides_seen = [false; 2];
     for seed in 0..40 {
-        let (mut obs, _) = env.reset(Some(seed));
+        let (obs, _) = env.reset(Some(seed));
         let towards_tips = obs.observation[OBJECT_POSITION + 1] < resting[1];
         if std::mem::replace(&mut sides_seen[usize::from(towards_tips)], true) {
             continue;
         }
-        let mut acting = gesturing.episode();
-        for step in 1..=4 {
-            let achieved = || obs.achieved_goal.clone();
-            let action =
-                acting.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
-            let expected = if towards_tips && step <= 2 {
+        let expected = |step, obs: &dexcube_env::Observation| {
+            if towards_tips && step <= 2 {
                 gesture.action(20)
             } else {
                 plain.act(&obs.observation, &obs.desired_goal)
-            };
-            assert_eq!(action, expected, "seed {seed}, step {step}");
+            }
+        };
+        let check = |acting: &dexcube_rl::policy::Acting| {
             assert_eq!(acting.gestured(), towards_tips);
-            obs = env.step(&action).observation;
-        }
+        };
+        assert_first_actions(&gesturing, &mut env, (seed, obs), expected, check);
     }
     assert_eq!(sides_seen, [true, true], "starts on both sides");
-    let refused = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
-        result.err().unwrap().to_string()
-    };
     let again = Policy::with_start_gesture(&out, gesture.clone(), &dir.join("x"), "test");
-    assert!(refused(again).contains("makes a start gesture already"));
+    assert!(refusal(again).contains("makes a start gesture already"));
     let lacking = StartGesture {
         actuators: vec![20],
         ..gesture
     };
     let lacking = Policy::with_start_gesture(&shipped, lacking, &dir.join("x"), "test");
-    assert!(refused(lacking).contains("not an actuator 20"));
+    assert!(refusal(lacking).contains("not an actuator 20"));
     let joined = Policy::ensemble(&[out.clone(), shipped.clone()], &dir.join("x"), "test");
-    assert!(refused(joined).contains("makes a start gesture"));
+    assert!(refusal(joined).contains("makes a start gesture"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -1008,13 +1039,7 @@ fn a_start_route_hands_the_thumbs_side_to_its_member() {
     };
     let routed = dir.join("routed");
     Policy::with_start_route(&joined, route, &routed, "test").unwrap();
-    let gesture = StartGesture {
-        actuators: vec![3, 6, 9, 13],
-        action: -1.0,
-        steps: 2,
-        below_y: resting[1],
-        member: None,
-    };
+    let gesture = knuckles(resting[1]);
     let out = dir.join("routed-gesture");
     Policy::with_start_gesture(&routed, gesture.clone(), &out, "test").unwrap();
     let policy = Policy::load(&out, &device).unwrap();
@@ -1023,49 +1048,37 @@ fn a_start_route_hands_the_thumbs_side_to_its_member() {
         Policy::load(&joined, &device).unwrap(),
         Policy::load(&wide, &device).unwrap(),
     );
-    let mut env = LayerOpEnv::new(ObjectKind::Cube, LayerMove::UPrime, LayerGoals::Evaluation)
-        .unwrap()
-        .with_goal(stages.stage2.goal)
-        .with_view(stages.stage2.view);
-    let test = env.goal();
+    let mut env = shipped_layer_env(&stages);
     // Towards the fingertips or not, towards the thumb or not.
     let mut quarters_seen = [false; 4];
     for seed in 0..400 {
-        let (mut obs, _) = env.reset(Some(seed));
+        let (obs, _) = env.reset(Some(seed));
         let position = &obs.observation[OBJECT_POSITION..OBJECT_POSITION + 2];
         let (towards_tips, towards_thumb) = (position[1] < resting[1], position[0] < resting[0]);
         let quarter = 2 * usize::from(towards_tips) + usize::from(towards_thumb);
         if std::mem::replace(&mut quarters_seen[quarter], true) {
             continue;
         }
-        let mut acting = policy.episode();
-        for step in 1..=4 {
-            let achieved = || obs.achieved_goal.clone();
-            let action =
-                acting.act_toward(&obs.observation, &obs.desired_goal, achieved, test.as_ref());
-            let expected = match (towards_tips, towards_thumb) {
-                (true, _) if step <= 2 => gesture.action(20),
-                (false, true) => member.act(&obs.observation, &obs.desired_goal),
-                _ => ensemble.act(&obs.observation, &obs.desired_goal),
-            };
-            assert_eq!(action, expected, "seed {seed}, step {step}");
+        let expected = |step, obs: &dexcube_env::Observation| match (towards_tips, towards_thumb) {
+            (true, _) if step <= 2 => gesture.action(20),
+            (false, true) => member.act(&obs.observation, &obs.desired_goal),
+            _ => ensemble.act(&obs.observation, &obs.desired_goal),
+        };
+        let check = |acting: &dexcube_rl::policy::Acting| {
             assert_eq!(acting.routed(), !towards_tips && towards_thumb);
-            obs = env.step(&action).observation;
-        }
+        };
+        assert_first_actions(&policy, &mut env, (seed, obs), expected, check);
         if quarters_seen == [true; 4] {
             break;
         }
     }
     assert_eq!(quarters_seen, [true; 4], "starts in every quarter");
-    let refused = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
-        result.err().unwrap().to_string()
-    };
     let again = Policy::with_start_route(&routed, route, &dir.join("x"), "test");
-    assert!(refused(again).contains("routes by the start already"));
+    assert!(refusal(again).contains("routes by the start already"));
     let single = Policy::with_start_route(&shipped, route, &dir.join("x"), "test");
-    assert!(refused(single).contains("single policy"));
+    assert!(refusal(single).contains("single policy"));
     let lacking = StartRoute { member: 2, ..route };
     let lacking = Policy::with_start_route(&joined, lacking, &dir.join("x"), "test");
-    assert!(refused(lacking).contains("not a member 2"));
+    assert!(refusal(lacking).contains("not a member 2"));
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -230,6 +230,17 @@ impl PolicyCard {
     }
 }
 
+/// Why an ensemble of `members` cannot name `member` (counted from 0), if it cannot.
+fn has_member(members: usize, member: usize) -> Result<(), String> {
+    if member >= members {
+        return Err(format!(
+            "it has {members} members (0 to {}), not a member {member}",
+            members - 1,
+        ));
+    }
+    Ok(())
+}
+
 /// The error for stored weights or cards at `path` that do not fit what they are used for.
 fn mismatch(path: &Path, message: String) -> CheckpointError {
     CheckpointError::Mismatch {
@@ -486,12 +497,7 @@ impl Policy {
                 );
             }
             for member in std::iter::once(handover.member).chain(handover.first) {
-                if member >= members {
-                    return Err(format!(
-                        "it has {members} members (0 to {}), not a member {member}",
-                        members - 1,
-                    ));
-                }
+                has_member(members, member)?;
             }
             if handover.first == Some(handover.member) && !letting_go {
                 return Err(format!(
@@ -554,6 +560,7 @@ impl Policy {
                 return Err(already.into());
             }
             route.check(card.dims, card.members())?;
+            has_member(card.members(), route.member)?;
             card.start_route = Some(route);
             Ok(())
         })

@@ -78,13 +78,7 @@ impl StartGesture {
     /// actuators, observing the cube's position), if it cannot.
     pub fn check(&self, dims: Dims) -> Result<(), String> {
         let actions = dims.action;
-        if dims.observation <= CUBE_Y {
-            return Err(format!(
-                "it observes {} numbers, without the cube's position: a start gesture is for \
-                 a stage policy of the hand",
-                dims.observation
-            ));
-        }
+        observes_cube_position(dims, "start gesture")?;
         if let Some(k) = self.actuators.iter().find(|&&k| k >= actions) {
             return Err(format!(
                 "the hand has {actions} actuators (0 to {}), not an actuator {k}",
@@ -102,6 +96,19 @@ impl StartGesture {
         }
         Ok(())
     }
+}
+
+/// Why a policy of `dims` cannot be given a setting (`what`) decided by where the cube starts
+/// on the palm, if it does not observe the cube's position.
+pub(crate) fn observes_cube_position(dims: Dims, what: &str) -> Result<(), String> {
+    if dims.observation <= CUBE_Y {
+        return Err(format!(
+            "it observes {} numbers, without the cube's position: a {what} is for a stage \
+             policy of the hand",
+            dims.observation
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::agent::Dims;
+use crate::start_gesture::observes_cube_position;
 
 /// Where the cube's position across the palm (x; the thumb lies towards -x, the little finger
 /// towards +x) sits in the observations both stages share.
@@ -44,28 +45,15 @@ impl StartRoute {
     }
 
     /// Why the route cannot be taken by a policy of `dims` with `members` ensemble members, if
-    /// it cannot.
+    /// it cannot (a member it lacks is the card's to refuse, as for a handover).
     pub fn check(&self, dims: Dims, members: usize) -> Result<(), String> {
-        if dims.observation <= CUBE_X {
-            return Err(format!(
-                "it observes {} numbers, without the cube's position: a start route is for a \
-                 stage policy of the hand",
-                dims.observation
-            ));
-        }
+        observes_cube_position(dims, "start route")?;
         if members < 2 {
             return Err(
                 "it is a single policy, with no member to route to: make an ensemble first \
                  (`dexcube ensemble`)"
                     .into(),
             );
-        }
-        if self.member >= members {
-            return Err(format!(
-                "it has {members} members (0 to {}), not a member {}",
-                members - 1,
-                self.member
-            ));
         }
         Ok(())
     }
