@@ -122,9 +122,9 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
             setup.prefix.display()
         );
     }
-    if teacher.card.start_route.is_some() {
+    if !teacher.card.start_routes.is_empty() {
         bail!(
-            "{} hands the episodes that start towards the thumb to one member, which a student \
+            "{} hands some episodes to one member by where the cube starts, which a student \
              labelled step by step cannot learn from its actions: distil the ensemble it was \
              made from (its card's metadata.start_route names it)",
             setup.prefix.display()

@@ -909,8 +909,8 @@ struct EpisodeTrace {
     handed_over: bool,
     /// A policy with a start gesture made it before it first acted.
     gestured: bool,
-    /// A policy with a start route handed the episode to its member.
-    routed: bool,
+    /// Which of a policy's start routes handed the episode to its member, if any.
+    route: Option<usize>,
 }
 
 /// What an episode keeps of its physics, for `--record-starts` (where the policy first acts
@@ -995,7 +995,7 @@ fn episode(
                 handover,
                 handed_over: acting.handed_over(),
                 gestured: acting.gestured(),
-                routed: acting.routed(),
+                route: acting.route(),
             };
         }
         obs = t.observation;
@@ -1014,11 +1014,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     // Stage 1 episodes that kept the cube and ended with a layer turned, and of them successes.
     let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
     // Episodes an ensemble handed to its member, and of them successes.
-    let (handovers, successes_handed_over) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let handed_over: [AtomicUsize; 2] = Default::default();
     // Episodes that began with a start gesture, and of them successes.
-    let (gestures, successes_gestured) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    // Episodes a start route took to its member, and of them successes.
-    let (routes, successes_routed) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let gestured: [AtomicUsize; 2] = Default::default();
     let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
     let (thresholds, control_rate) = (setup.thresholds, setup.settings.rate);
     if args.record && args.physics_spread > 0.0 {
@@ -1057,8 +1055,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     }
     let (prefix, object, scene) = (setup.prefix.clone(), setup.object, setup.scene.clone());
     let card = PolicyCard::read(&prefix)?;
-    let (handover, start_gesture, start_route) =
-        (card.handover, card.start_gesture, card.start_route);
+    let (handover, start_gesture, start_routes) =
+        (card.handover, card.start_gesture, card.start_routes);
+    // Episodes each start route took to its member, and of them successes.
+    let routed: Vec<[AtomicUsize; 2]> = start_routes.iter().map(|_| Default::default()).collect();
     if args.record_handovers.is_some() && handover.is_none() {
         bail!(
             "--record-handovers keeps where an ensemble hands an episode to its member, and {} \
@@ -1178,16 +1178,18 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     successes_with_layer_turns.fetch_add(1, Ordering::Relaxed);
                 }
             }
-            for (happened, count, successes) in [
-                (trace.handed_over, &handovers, &successes_handed_over),
-                (trace.gestured, &gestures, &successes_gestured),
-                (trace.routed, &routes, &successes_routed),
-            ] {
-                if happened {
-                    count.fetch_add(1, Ordering::Relaxed);
-                    if ending == Ending::Success {
-                        successes.fetch_add(1, Ordering::Relaxed);
-                    }
+            let route = trace.route.map(|k| &routed[k]);
+            let counted = [
+                (trace.handed_over, &handed_over),
+                (trace.gestured, &gestured),
+            ];
+            for [count, successes] in (counted.into_iter().filter(|(happened, _)| *happened))
+                .map(|(_, counts)| counts)
+                .chain(route)
+            {
+                count.fetch_add(1, Ordering::Relaxed);
+                if ending == Ending::Success {
+                    successes.fetch_add(1, Ordering::Relaxed);
                 }
             }
             if args.episodes_csv.is_some() {
@@ -1305,23 +1307,23 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         println!(
             "  handed over to member {} in {} episodes ({} of them successes)",
             handover.member,
-            handovers.into_inner(),
-            successes_handed_over.into_inner()
+            handed_over[0].load(Ordering::Relaxed),
+            handed_over[1].load(Ordering::Relaxed)
         );
     }
     if start_gesture.is_some() {
         println!(
             "  began with the start gesture in {} episodes ({} of them successes)",
-            gestures.into_inner(),
-            successes_gestured.into_inner()
+            gestured[0].load(Ordering::Relaxed),
+            gestured[1].load(Ordering::Relaxed)
         );
     }
-    if let Some(route) = start_route {
+    for (route, [routes, successes]) in start_routes.iter().zip(&routed) {
         println!(
             "  routed to member {} in {} episodes ({} of them successes)",
             route.member,
-            routes.into_inner(),
-            successes_routed.into_inner()
+            routes.load(Ordering::Relaxed),
+            successes.load(Ordering::Relaxed)
         );
     }
     for (count, steps) in held.iter().zip(HOLDS) {

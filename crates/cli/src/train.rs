@@ -13,7 +13,7 @@ use dexcube_env::{
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::handover::Handover;
 use dexcube_rl::start_gesture::StartGesture;
-use dexcube_rl::start_route::StartRoute;
+use dexcube_rl::start_route::{RoutedEpisodes, StartRoute};
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
 use dexcube_sim::Scene;
 
@@ -450,23 +450,42 @@ pub struct StartRouteArgs {
     /// .safetensors and .json less the extension.
     policy: PathBuf,
     /// The member (0 is the first) that acts alone, before and after any handover, in the
-    /// episodes whose cube starts towards the thumb and that make no start gesture.
+    /// episodes the route takes: by default those whose cube starts towards the thumb and
+    /// that make no start gesture.
     #[arg(long, value_name = "M")]
     member: usize,
+    /// Take instead the episodes that make the card's start gesture with the cube starting
+    /// within DEG degrees of square to the hand (the yaw `stage2_start_geometry --max-yaw`
+    /// reads).
+    #[arg(long, value_name = "DEG")]
+    near_square: Option<f64>,
     /// Where to write the result (PATH.safetensors and PATH.json).
     #[arg(long)]
     out: PathBuf,
 }
 
 pub fn start_route(args: StartRouteArgs) -> anyhow::Result<ExitCode> {
-    // The thumb's side is told from where the physical cube comes to rest on the palm.
-    let resting = dexcube_operator::eval::resting_point()?;
-    let route = StartRoute {
-        below_x: resting[0],
-        member: args.member,
+    let episodes = match args.near_square {
+        Some(max_yaw) if (0.0..=45.0).contains(&max_yaw) => {
+            RoutedEpisodes::GesturedNearSquare { max_yaw }
+        }
+        Some(max_yaw) => {
+            bail!("--near-square is a yaw from square, 0 to 45 degrees, not {max_yaw}")
+        }
+        // The thumb's side is told from where the physical cube comes to rest on the palm.
+        None => RoutedEpisodes::TowardsThumb {
+            below_x: dexcube_operator::eval::resting_point()?[0],
+        },
     };
+    let route = StartRoute {
+        member: args.member,
+        episodes,
+    };
+    let near_square = args
+        .near_square
+        .map_or(String::new(), |deg| format!(" --near-square {deg}"));
     let command = format!(
-        "dexcube start-route {} --member {} --out {}",
+        "dexcube start-route {} --member {}{near_square} --out {}",
         args.policy.display(),
         route.member,
         args.out.display()

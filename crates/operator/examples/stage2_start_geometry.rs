@@ -20,11 +20,9 @@
 
 use std::path::Path;
 
-use dexcube_cube::Face;
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{LayerOpEnv, SimulatedEnv};
-use dexcube_sim::cube::face_normal;
-use dexcube_sim::rotation::rotate;
+use dexcube_sim::cube::yaw_from_square;
 use dexcube_sim::{Scene, SceneKind, Sim};
 
 const YAW_BINS: [(f64, f64); 5] = [
@@ -101,14 +99,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for start in &recorded {
             env.reset_from(start)?;
             let pose = env.sim().object_pose();
-            // The side face whose normal lies most nearly level gives the yaw.
-            let side = [Face::R, Face::B, Face::U]
-                .map(|face| rotate(&pose.orientation, face_normal(face)))
-                .into_iter()
-                .min_by(|a, b| a[2].abs().total_cmp(&b[2].abs()))
-                .expect("three faces");
-            let yaw = side[1].atan2(side[0]).to_degrees().rem_euclid(90.0);
-            let yaw = yaw.min(90.0 - yaw);
+            let yaw = yaw_from_square(&pose.orientation);
             let offset = [0, 1].map(|k| 1000.0 * (pose.position[k] - resting[k]));
             if let Some(((_, _, side), only, _)) = &mark {
                 let there = on_side(offset, *side) && max_yaw.is_none_or(|most| yaw <= most);

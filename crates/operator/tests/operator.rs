@@ -19,8 +19,8 @@ use dexcube_operator::{
 };
 use dexcube_rl::Policy;
 use dexcube_rl::start_gesture::StartGesture;
-use dexcube_rl::start_route::StartRoute;
-use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, snap_layers};
+use dexcube_rl::start_route::{RoutedEpisodes, StartRoute};
+use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, snap_layers, yaw_from_square};
 use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{Pose, Scene, SceneKind, Sim};
 use rand::SeedableRng;
@@ -1019,12 +1019,15 @@ fn a_start_gesture_comes_first_only_towards_the_fingertips() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// An ensemble with a start route hands the episodes whose cube starts towards the thumb to
-/// its member, acting alone from the first step, unless the episode makes the start gesture
-/// (which comes first, as the card says). Every other episode acts as the ensemble does. A
-/// second route, a single policy and a member it lacks are refused.
+/// An ensemble with start routes hands the episodes whose cube starts towards the thumb to
+/// one member, acting alone from the first step, unless the episode makes the start gesture
+/// (which comes first, as the card says); and the episodes that make the gesture with the cube
+/// near square to the hand (the yaw read from the physics, as `stage2_start_geometry` reads
+/// it) to another, after the gesture. Every other episode acts as the ensemble does. A second
+/// route of a kind, a near-square route without a gesture, a single policy and a member it
+/// lacks are refused.
 #[test]
-fn a_start_route_hands_the_thumbs_side_to_its_member() {
+fn start_routes_hand_the_thumbs_side_and_near_square_gestures_to_their_members() {
     let (stages, resting) = shipped_stages();
     let device = burn::prelude::Device::flex();
     let dir = std::env::temp_dir().join(format!("dexcube-start-route-{}", std::process::id()));
@@ -1033,51 +1036,66 @@ fn a_start_route_hands_the_thumbs_side_to_its_member() {
     let (shipped, wide) = (models.join("layer"), models.join("layer-w512-19"));
     let joined = dir.join("joined");
     Policy::ensemble(&[shipped.clone(), wide.clone()], &joined, "test").unwrap();
-    let route = StartRoute {
-        below_x: resting[0],
+    let thumb = StartRoute {
         member: 1,
+        episodes: RoutedEpisodes::TowardsThumb {
+            below_x: resting[0],
+        },
+    };
+    let square = StartRoute {
+        member: 0,
+        episodes: RoutedEpisodes::GesturedNearSquare { max_yaw: 15.0 },
     };
     let routed = dir.join("routed");
-    Policy::with_start_route(&joined, route, &routed, "test").unwrap();
+    Policy::with_start_route(&joined, thumb, &routed, "test").unwrap();
     let gesture = knuckles(resting[1]);
-    let out = dir.join("routed-gesture");
-    Policy::with_start_gesture(&routed, gesture.clone(), &out, "test").unwrap();
+    let gesturing = dir.join("routed-gesture");
+    Policy::with_start_gesture(&routed, gesture.clone(), &gesturing, "test").unwrap();
+    let out = dir.join("routed-gesture-square");
+    Policy::with_start_route(&gesturing, square, &out, "test").unwrap();
     let policy = Policy::load(&out, &device).unwrap();
-    assert_eq!(policy.card.start_route, Some(route));
-    let (ensemble, member) = (
-        Policy::load(&joined, &device).unwrap(),
-        Policy::load(&wide, &device).unwrap(),
-    );
+    assert_eq!(policy.card.start_routes, [thumb, square]);
+    let ensemble = Policy::load(&joined, &device).unwrap();
+    let members = [&shipped, &wide].map(|member| Policy::load(member, &device).unwrap());
     let mut env = shipped_layer_env(&stages);
-    // Towards the fingertips or not, towards the thumb or not.
-    let mut quarters_seen = [false; 4];
+    // Near square towards the fingertips or not, then towards the thumb or not elsewhere.
+    let mut kinds_seen = [false; 4];
     for seed in 0..400 {
         let (obs, _) = env.reset(Some(seed));
         let position = &obs.observation[OBJECT_POSITION..OBJECT_POSITION + 2];
         let (towards_tips, towards_thumb) = (position[1] < resting[1], position[0] < resting[0]);
-        let quarter = 2 * usize::from(towards_tips) + usize::from(towards_thumb);
-        if std::mem::replace(&mut quarters_seen[quarter], true) {
+        let near_square = yaw_from_square(&env.sim().object_pose().orientation) <= 15.0;
+        let kind = match towards_tips {
+            true => usize::from(near_square),
+            false => 2 + usize::from(towards_thumb),
+        };
+        if std::mem::replace(&mut kinds_seen[kind], true) {
             continue;
         }
-        let expected = |step, obs: &dexcube_env::Observation| match (towards_tips, towards_thumb) {
-            (true, _) if step <= 2 => gesture.action(20),
-            (false, true) => member.act(&obs.observation, &obs.desired_goal),
-            _ => ensemble.act(&obs.observation, &obs.desired_goal),
+        let expected = |step, obs: &dexcube_env::Observation| {
+            let acting = match kind {
+                _ if towards_tips && step <= 2 => return gesture.action(20),
+                1 => &members[0],
+                3 => &members[1],
+                _ => &ensemble,
+            };
+            acting.act(&obs.observation, &obs.desired_goal)
         };
-        let check = |acting: &dexcube_rl::policy::Acting| {
-            assert_eq!(acting.routed(), !towards_tips && towards_thumb);
-        };
+        let route = [None, Some(1), None, Some(0)][kind];
+        let check = |acting: &dexcube_rl::policy::Acting| assert_eq!(acting.route(), route);
         assert_first_actions(&policy, &mut env, (seed, obs), expected, check);
-        if quarters_seen == [true; 4] {
+        if kinds_seen == [true; 4] {
             break;
         }
     }
-    assert_eq!(quarters_seen, [true; 4], "starts in every quarter");
-    let again = Policy::with_start_route(&routed, route, &dir.join("x"), "test");
-    assert!(refusal(again).contains("routes by the start already"));
-    let single = Policy::with_start_route(&shipped, route, &dir.join("x"), "test");
+    assert_eq!(kinds_seen, [true; 4], "starts of every kind");
+    let again = Policy::with_start_route(&routed, thumb, &dir.join("x"), "test");
+    assert!(refusal(again).contains("routes such episodes already"));
+    let no_gesture = Policy::with_start_route(&joined, square, &dir.join("x"), "test");
+    assert!(refusal(no_gesture).contains("makes no start gesture"));
+    let single = Policy::with_start_route(&shipped, thumb, &dir.join("x"), "test");
     assert!(refusal(single).contains("single policy"));
-    let lacking = StartRoute { member: 2, ..route };
+    let lacking = StartRoute { member: 2, ..thumb };
     let lacking = Policy::with_start_route(&joined, lacking, &dir.join("x"), "test");
     assert!(refusal(lacking).contains("not a member 2"));
     std::fs::remove_dir_all(&dir).unwrap();

@@ -54,10 +54,11 @@ pub struct PolicyCard {
     /// the fingertips; none for the paper's, which acts from the first step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub start_gesture: Option<StartGesture>,
-    /// A member that acts alone where the cube starts towards the thumb and no gesture is
-    /// made; none for the paper's.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub start_route: Option<StartRoute>,
+    /// Members that act alone in the episodes picked by where the cube starts (towards the
+    /// thumb without a gesture, near square with one), the first that takes an episode
+    /// winning; none for the paper's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub start_routes: Vec<StartRoute>,
 }
 
 /// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
@@ -200,7 +201,7 @@ impl PolicyCard {
 
     /// What on the card, besides the weights, decides how the policy acts: its guide's
     /// settings (how many candidates, how far, drawn from which seed), its goal lead, its
-    /// handover, its start gesture and its start route.
+    /// handover, its start gesture and its start routes.
     /// None for a policy that acts on its weights alone.
     pub fn acting_settings(&self) -> Option<serde_json::Value> {
         let mut settings = serde_json::Map::new();
@@ -223,8 +224,8 @@ impl PolicyCard {
         if let Some(gesture) = &self.start_gesture {
             settings.insert("start_gesture".into(), serde_json::json!(gesture));
         }
-        if let Some(route) = &self.start_route {
-            settings.insert("start_route".into(), serde_json::json!(route));
+        if !self.start_routes.is_empty() {
+            settings.insert("start_routes".into(), serde_json::json!(self.start_routes));
         }
         (!settings.is_empty()).then_some(serde_json::Value::Object(settings))
     }
@@ -274,7 +275,7 @@ impl Policy {
             goal_lead: None,
             handover: None,
             start_gesture: None,
-            start_route: None,
+            start_routes: Vec::new(),
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -543,8 +544,8 @@ impl Policy {
     }
 
     /// Writes at `out` the ensemble at `policy` (with any of the settings above) routing the
-    /// episodes that start towards the thumb, and make no gesture, to one member as `route`
-    /// says ([`StartRoute`]); its weights are unchanged. The card records the policy and
+    /// episodes `route` picks by where the cube starts to one member ([`StartRoute`]), after
+    /// any routes it has; its weights are unchanged. The card records the policy and
     /// `command`, the command that made it.
     pub fn with_start_route(
         policy: &Path,
@@ -554,14 +555,14 @@ impl Policy {
     ) -> Result<(), CheckpointError> {
         let how = route.to_string();
         restated(policy, (out, command), ("start_route", how), |card| {
-            if card.start_route.is_some() {
-                let already =
-                    "it routes by the start already: start from the policy it was made from";
+            if card.start_routes.iter().any(|r| r.same_kind(&route)) {
+                let already = "it routes such episodes already: start from the policy it was \
+                               made from";
                 return Err(already.into());
             }
-            route.check(card.dims, card.members())?;
+            route.check(card.dims, card.members(), card.start_gesture.is_some())?;
             has_member(card.members(), route.member)?;
-            card.start_route = Some(route);
+            card.start_routes.push(route);
             Ok(())
         })
     }
@@ -615,7 +616,7 @@ impl Policy {
                 goal_lead: None,
                 handover: None,
                 start_gesture: None,
-                start_route: None,
+                start_routes: Vec::new(),
                 ..self.card.clone()
             },
             actor,
@@ -651,7 +652,7 @@ impl Policy {
             watch: self.card.handover.map(HandoverWatch::new),
             steps: 0,
             gesture: None,
-            routed: None,
+            route: None,
         }
     }
 
@@ -705,9 +706,9 @@ pub struct Acting<'a> {
     /// The start gesture's action, where this episode makes it (decided at the first step; it
     /// lasts the card's `start_gesture.steps`).
     gesture: Option<Vec<f64>>,
-    /// Whether the card's start route applies to this episode (decided at the first step,
-    /// after the gesture; none before it).
-    routed: Option<bool>,
+    /// Which of the card's start routes took this episode, if any (decided at the first step,
+    /// before any gesture; none before it).
+    route: Option<Option<usize>>,
 }
 
 impl Acting<'_> {
@@ -715,8 +716,8 @@ impl Acting<'_> {
     /// start gesture's for its first steps where the card has one and the cube started towards
     /// the fingertips; then shown the goal led on where the card says so, from the object's
     /// goal now, and by the member handed over to once the episode has stalled, where it says
-    /// so, or throughout by the gesture's own member in an episode that made a gesture naming
-    /// one; `achieved` reads the object's goal only for these.
+    /// so, or throughout by the member of the start route that took the episode, or else of
+    /// the gesture, where either names one; `achieved` reads the object's goal only for these.
     pub fn act_toward(
         &mut self,
         observation: &[f64],
@@ -725,10 +726,19 @@ impl Acting<'_> {
         test: &dyn Goal,
     ) -> Vec<f64> {
         let policy = self.policy;
-        if let Some(gesture) = &policy.card.start_gesture {
-            if self.steps == 0 && gesture.applies(observation) {
-                self.gesture = Some(gesture.action(policy.card.dims.action));
-            }
+        let card = &policy.card;
+        if self.route.is_none() {
+            // The first step: where the cube starts decides the gesture and the route.
+            let gesture = card.start_gesture.as_ref();
+            self.gesture = gesture
+                .filter(|gesture| gesture.applies(observation))
+                .map(|gesture| gesture.action(card.dims.action));
+            let gestured = self.gesture.is_some();
+            self.route = Some(
+                (card.start_routes.iter()).position(|route| route.applies(observation, gestured)),
+            );
+        }
+        if let Some(gesture) = &card.start_gesture {
             self.steps += 1;
             if let Some(action) = &self.gesture
                 && self.steps <= gesture.steps
@@ -736,19 +746,15 @@ impl Acting<'_> {
                 return action.clone();
             }
         }
-        // A specialist member acts alone, before and after any handover, in the episodes
-        // that made the gesture or that the start route takes; otherwise the member the turn
-        // names, or all of them.
-        let gestured = self.gesture.is_some();
-        let route = policy.card.start_route;
-        let routed = *self.routed.get_or_insert_with(|| {
-            !gestured && route.is_some_and(|route| route.applies(observation))
-        });
-        let specialist = match (gestured, routed) {
-            (true, _) => policy.card.start_gesture.as_ref().and_then(|g| g.member),
-            (false, true) => route.map(|route| route.member),
-            (false, false) => None,
-        };
+        // A specialist member acts alone, before and after any handover, in the episodes a
+        // start route took or that made the gesture; otherwise the member the turn names, or
+        // all of them.
+        let routed = self.route.flatten().map(|k| card.start_routes[k].member);
+        let gestured = self
+            .gesture
+            .as_ref()
+            .and_then(|_| card.start_gesture.as_ref());
+        let specialist = routed.or(gestured.and_then(|gesture| gesture.member));
         let act = |member: Option<usize>, goal: &[f64]| match specialist.or(member) {
             Some(member) => policy.member_action(member, observation, goal),
             None => policy.act(observation, goal),
@@ -773,9 +779,9 @@ impl Acting<'_> {
         }
     }
 
-    /// Whether the card's start route took the episode to its member.
-    pub fn routed(&self) -> bool {
-        self.routed == Some(true)
+    /// Which of the card's start routes took the episode to its member, if any.
+    pub fn route(&self) -> Option<usize> {
+        self.route.flatten()
     }
 
     /// Whether the episode began with the start gesture.

@@ -335,6 +335,20 @@ pub fn face_normal(face: Face) -> [f64; 3] {
     }
 }
 
+/// How far, in degrees from 0 to 45, a cube with `orientation` lying on one face is turned
+/// about the vertical from square to the world's x and y axes (the hand's, on the palm): the
+/// side face whose normal lies most nearly level gives the yaw, a cube's sides repeating every
+/// 90 degrees. Any of the cube's symmetries applied to `orientation` gives the same yaw.
+pub fn yaw_from_square(orientation: &Quat) -> f64 {
+    let side = [Face::R, Face::B, Face::U]
+        .map(|face| rotation::rotate(orientation, face_normal(face)))
+        .into_iter()
+        .min_by(|a, b| a[2].abs().total_cmp(&b[2].abs()))
+        .expect("three faces");
+    let yaw = side[1].atan2(side[0]).to_degrees().rem_euclid(90.0);
+    yaw.min(90.0 - yaw)
+}
+
 /// The direction from the cube's centre to a corner slot (components ±1).
 fn slot_centre(slot: usize) -> [f64; 3] {
     CORNER_NAMES[slot].chars().fold([0.0; 3], |acc, letter| {
