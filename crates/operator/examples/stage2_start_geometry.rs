@@ -2,7 +2,8 @@
 //! --record-starts`, or `dexcube eval --record-layer-starts`), how many starts, and how many
 //! of them the recorded policy failed from, by the cube's yaw on the palm (how far its side
 //! faces turn from square to the hand's axes, 0 to 45 degrees, a cube's sides repeating every
-//! 90), by how far it sits from the palm's resting point across the palm, and by which side
+//! 90; read from the policy's first observation, as a start route reads it, since session 59),
+//! by how far it sits from the palm's resting point across the palm, and by which side
 //! of that point it sits: the thumb lies towards -x and the little finger towards +x, the
 //! fingertips towards -y and the wrist towards +y (before session 38 this said the fingertips
 //! lay towards -x, and the sides were printed so).
@@ -22,7 +23,7 @@ use std::path::Path;
 
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{LayerOpEnv, SimulatedEnv};
-use dexcube_sim::cube::yaw_from_square;
+use dexcube_rl::start_route::yaw_seen;
 use dexcube_sim::{Scene, SceneKind, Sim};
 
 const YAW_BINS: [(f64, f64); 5] = [
@@ -97,9 +98,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (recorded, origin) = dexcube_rl::start_file::load_starts(Path::new(path))?;
         first_origin.get_or_insert(origin);
         for start in &recorded {
-            env.reset_from(start)?;
+            // The yaw as the policy sees it at the first step, where a start route reads it.
+            let (observation, _) = env.reset_from(start)?;
+            let yaw = yaw_seen(&observation.observation);
             let pose = env.sim().object_pose();
-            let yaw = yaw_from_square(&pose.orientation);
             let offset = [0, 1].map(|k| 1000.0 * (pose.position[k] - resting[k]));
             if let Some(((_, _, side), only, _)) = &mark {
                 let there = on_side(offset, *side) && max_yaw.is_none_or(|most| yaw <= most);

@@ -22,6 +22,14 @@ pub const CUBE_X: usize = dexcube_env::OBJECT_POSITION;
 /// Where the cube's orientation (a unit quaternion, w first) sits in them, after its position.
 pub const CUBE_ORIENTATION: usize = dexcube_env::OBJECT_POSITION + 3;
 
+/// The cube's yaw from square to the hand, in degrees from 0 to 45, as a policy sees it in
+/// `observation` ([`dexcube_sim::cube::yaw_from_square`] of the orientation it is shown: the
+/// frame of the layer that stays, which may differ from the cube's own by its misalignment).
+pub fn yaw_seen(observation: &[f64]) -> f64 {
+    let q = &observation[CUBE_ORIENTATION..CUBE_ORIENTATION + 4];
+    dexcube_sim::cube::yaw_from_square(&[q[0], q[1], q[2], q[3]])
+}
+
 /// In the episodes `episodes` picks, ensemble member `member` acts alone, before and after
 /// any handover; every other episode goes on as the card says.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -38,7 +46,7 @@ pub enum RoutedEpisodes {
     /// palm's resting point, in world metres: towards the thumb; session 58).
     TowardsThumb { below_x: f64 },
     /// Those that make the card's start gesture and whose cube starts within `max_yaw`
-    /// degrees of square to the hand ([`dexcube_sim::cube::yaw_from_square`]; session 59).
+    /// degrees of square to the hand ([`yaw_seen`]; session 59).
     GesturedNearSquare { max_yaw: f64 },
 }
 
@@ -67,9 +75,7 @@ impl StartRoute {
         match self.episodes {
             RoutedEpisodes::TowardsThumb { below_x } => !gestured && observation[CUBE_X] < below_x,
             RoutedEpisodes::GesturedNearSquare { max_yaw } => {
-                let q = &observation[CUBE_ORIENTATION..CUBE_ORIENTATION + 4];
-                let yaw = dexcube_sim::cube::yaw_from_square(&[q[0], q[1], q[2], q[3]]);
-                gestured && yaw <= max_yaw
+                gestured && yaw_seen(observation) <= max_yaw
             }
         }
     }
