@@ -750,11 +750,11 @@ impl Acting<'_> {
         // start route took or that made the gesture; otherwise the member the turn names, or
         // all of them.
         let routed = self.route.flatten().map(|k| card.start_routes[k].member);
-        let gestured = self
-            .gesture
+        let gesture_member = card
+            .start_gesture
             .as_ref()
-            .and_then(|_| card.start_gesture.as_ref());
-        let specialist = routed.or(gestured.and_then(|gesture| gesture.member));
+            .and_then(|gesture| gesture.member);
+        let specialist = routed.or(self.gesture.as_ref().and(gesture_member));
         let act = |member: Option<usize>, goal: &[f64]| match specialist.or(member) {
             Some(member) => policy.member_action(member, observation, goal),
             None => policy.act(observation, goal),
