@@ -1178,14 +1178,13 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     successes_with_layer_turns.fetch_add(1, Ordering::Relaxed);
                 }
             }
-            let route = trace.route.map(|k| &routed[k]);
-            let counted = [
-                (trace.handed_over, &handed_over),
-                (trace.gestured, &gestured),
-            ];
-            for [count, successes] in (counted.into_iter().filter(|(happened, _)| *happened))
-                .map(|(_, counts)| counts)
-                .chain(route)
+            for [count, successes] in [
+                trace.handed_over.then_some(&handed_over),
+                trace.gestured.then_some(&gestured),
+                trace.route.map(|k| &routed[k]),
+            ]
+            .into_iter()
+            .flatten()
             {
                 count.fetch_add(1, Ordering::Relaxed);
                 if ending == Ending::Success {

@@ -64,10 +64,10 @@ enum Command {
     /// the knuckles straightened first). Writes a policy that loads and runs as any other; its
     /// weights are unchanged.
     StartGesture(train::StartGestureArgs),
-    /// Lets an ensemble hand the episodes whose cube starts towards the thumb (and that make
-    /// no start gesture) to one member, acting alone throughout: a specialist for that quarter
-    /// of the palm. Writes a policy that loads and runs as any other; its weights are
-    /// unchanged.
+    /// Lets an ensemble hand the episodes picked by where the cube starts to one member,
+    /// acting alone throughout: those towards the thumb that make no start gesture, or (with
+    /// --near-square) those that make it with the cube near square to the hand. Writes a policy
+    /// that loads and runs as any other; its weights are unchanged.
     StartRoute(train::StartRouteArgs),
     /// Teaches one actor to act as a stage policy does (an ensemble, typically) by DAgger:
     /// the teacher labels every state of episodes run first by itself, then by the student.

@@ -466,12 +466,7 @@ pub struct StartRouteArgs {
 
 pub fn start_route(args: StartRouteArgs) -> anyhow::Result<ExitCode> {
     let episodes = match args.near_square {
-        Some(max_yaw) if (0.0..=45.0).contains(&max_yaw) => {
-            RoutedEpisodes::GesturedNearSquare { max_yaw }
-        }
-        Some(max_yaw) => {
-            bail!("--near-square is a yaw from square, 0 to 45 degrees, not {max_yaw}")
-        }
+        Some(max_yaw) => RoutedEpisodes::GesturedNearSquare { max_yaw },
         // The thumb's side is told from where the physical cube comes to rest on the palm.
         None => RoutedEpisodes::TowardsThumb {
             below_x: dexcube_operator::eval::resting_point()?[0],

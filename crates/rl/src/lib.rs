@@ -17,8 +17,8 @@
 //!   and trying again;
 //! - [`start_gesture`]: a gesture the hand makes before a policy first acts, where the cube
 //!   starts towards the fingertips;
-//! - [`start_route`]: an ensemble member that acts alone where the cube starts towards the
-//!   thumb;
+//! - [`start_route`]: ensemble members that act alone in the episodes picked by where the
+//!   cube starts (towards the thumb, or near square where the start gesture is made);
 //! - [`distil`]: one actor fitted to act as another policy (an ensemble) does, by DAgger;
 //! - [`point_mass`]: a small reaching task that proves the learner in seconds.
 //!

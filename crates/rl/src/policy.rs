@@ -701,14 +701,14 @@ impl Policy {
 pub struct Acting<'a> {
     policy: &'a Policy,
     watch: Option<HandoverWatch>,
-    /// Control steps acted so far, counted where the card has a start gesture.
+    /// Control steps acted so far.
     steps: usize,
     /// The start gesture's action, where this episode makes it (decided at the first step; it
     /// lasts the card's `start_gesture.steps`).
     gesture: Option<Vec<f64>>,
     /// Which of the card's start routes took this episode, if any (decided at the first step,
-    /// before any gesture; none before it).
-    route: Option<Option<usize>>,
+    /// before any gesture).
+    route: Option<usize>,
 }
 
 impl Acting<'_> {
@@ -727,29 +727,26 @@ impl Acting<'_> {
     ) -> Vec<f64> {
         let policy = self.policy;
         let card = &policy.card;
-        if self.route.is_none() {
+        if self.steps == 0 {
             // The first step: where the cube starts decides the gesture and the route.
             let gesture = card.start_gesture.as_ref();
             self.gesture = gesture
                 .filter(|gesture| gesture.applies(observation))
                 .map(|gesture| gesture.action(card.dims.action));
             let gestured = self.gesture.is_some();
-            self.route = Some(
-                (card.start_routes.iter()).position(|route| route.applies(observation, gestured)),
-            );
+            self.route =
+                (card.start_routes.iter()).position(|route| route.applies(observation, gestured));
         }
-        if let Some(gesture) = &card.start_gesture {
-            self.steps += 1;
-            if let Some(action) = &self.gesture
-                && self.steps <= gesture.steps
-            {
-                return action.clone();
-            }
+        self.steps += 1;
+        if let (Some(action), Some(gesture)) = (&self.gesture, &card.start_gesture)
+            && self.steps <= gesture.steps
+        {
+            return action.clone();
         }
         // A specialist member acts alone, before and after any handover, in the episodes a
         // start route took or that made the gesture; otherwise the member the turn names, or
         // all of them.
-        let routed = self.route.flatten().map(|k| card.start_routes[k].member);
+        let routed = self.route.map(|k| card.start_routes[k].member);
         let gesture_member = card
             .start_gesture
             .as_ref()
@@ -781,7 +778,7 @@ impl Acting<'_> {
 
     /// Which of the card's start routes took the episode to its member, if any.
     pub fn route(&self) -> Option<usize> {
-        self.route.flatten()
+        self.route
     }
 
     /// Whether the episode began with the start gesture.

@@ -26,8 +26,10 @@ pub const CUBE_ORIENTATION: usize = dexcube_env::OBJECT_POSITION + 3;
 /// `observation` ([`dexcube_sim::cube::yaw_from_square`] of the orientation it is shown: the
 /// frame of the layer that stays, which may differ from the cube's own by its misalignment).
 pub fn yaw_seen(observation: &[f64]) -> f64 {
-    let q = &observation[CUBE_ORIENTATION..CUBE_ORIENTATION + 4];
-    dexcube_sim::cube::yaw_from_square(&[q[0], q[1], q[2], q[3]])
+    let orientation = observation[CUBE_ORIENTATION..CUBE_ORIENTATION + 4]
+        .try_into()
+        .expect("four numbers");
+    dexcube_sim::cube::yaw_from_square(orientation)
 }
 
 /// In the episodes `episodes` picks, ensemble member `member` acts alone, before and after
@@ -92,12 +94,19 @@ impl StartRoute {
                     .into(),
             );
         }
-        if matches!(self.episodes, RoutedEpisodes::GesturedNearSquare { .. }) && !gesturing {
-            return Err(
-                "it makes no start gesture, so no episode would be routed: give it one first \
-                 (`dexcube start-gesture`)"
-                    .into(),
-            );
+        if let RoutedEpisodes::GesturedNearSquare { max_yaw } = self.episodes {
+            if !(0.0..=45.0).contains(&max_yaw) {
+                return Err(format!(
+                    "a yaw from square is 0 to 45 degrees, not {max_yaw}"
+                ));
+            }
+            if !gesturing {
+                return Err(
+                    "it makes no start gesture, so no episode would be routed: give it one \
+                     first (`dexcube start-gesture`)"
+                        .into(),
+                );
+            }
         }
         Ok(())
     }
