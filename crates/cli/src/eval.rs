@@ -905,8 +905,8 @@ struct EpisodeTrace {
     /// Where an ensemble that hands over handed the episode to its member, when asked for;
     /// Stage 1 only, as for `closest`.
     handover: Option<RecordedStart>,
-    /// An ensemble with a handover handed the episode to its member.
-    handed_over: bool,
+    /// The member an ensemble with a handover handed the episode to, if it did.
+    handed_to: Option<usize>,
     /// A policy with a start gesture made it before it first acted.
     gestured: bool,
     /// Which of a policy's start routes handed the episode to its member, if any.
@@ -993,7 +993,7 @@ fn episode(
                 start,
                 closest,
                 handover,
-                handed_over: acting.handed_over(),
+                handed_to: acting.handed_to(),
                 gestured: acting.gestured(),
                 route: acting.route(),
             };
@@ -1013,8 +1013,6 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     let wins_out_of_square = AtomicUsize::new(0);
     // Stage 1 episodes that kept the cube and ended with a layer turned, and of them successes.
     let (layer_turns, successes_with_layer_turns) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    // Episodes an ensemble handed to its member, and of them successes.
-    let handed_over: [AtomicUsize; 2] = Default::default();
     // Episodes that began with a start gesture, and of them successes.
     let gestured: [AtomicUsize; 2] = Default::default();
     let mut setup = StageSetup::new(args.stage, &files, args.object, args.control_rate)?;
@@ -1055,6 +1053,9 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     }
     let (prefix, object, scene) = (setup.prefix.clone(), setup.object, setup.scene.clone());
     let card = PolicyCard::read(&prefix)?;
+    // Episodes an ensemble handed to each member, and of them successes.
+    let handed_over: Vec<[AtomicUsize; 2]> =
+        (0..card.members()).map(|_| Default::default()).collect();
     let (handover, start_gesture, start_routes) =
         (card.handover, card.start_gesture, card.start_routes);
     // Episodes each start route took to its member, and of them successes.
@@ -1179,7 +1180,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 }
             }
             for [count, successes] in [
-                trace.handed_over.then_some(&handed_over),
+                trace.handed_to.map(|k| &handed_over[k]),
                 trace.gestured.then_some(&gestured),
                 trace.route.map(|k| &routed[k]),
             ]
@@ -1206,7 +1207,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                     trace.turned_a_layer,
                     trace.longest_hold,
                     trace.start_angle_error,
-                    trace.handed_over,
+                    trace.handed_to.is_some(),
                 );
                 rows.lock().expect("no thread panics").push((k, row));
             }
@@ -1303,12 +1304,20 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if let Some(handover) = handover {
-        println!(
-            "  handed over to member {} in {} episodes ({} of them successes)",
-            handover.member,
-            handed_over[0].load(Ordering::Relaxed),
-            handed_over[1].load(Ordering::Relaxed)
-        );
+        let far = handover.far.map(|far| {
+            (
+                far.member,
+                format!(" (stalled {} rad or more off)", far.beyond),
+            )
+        });
+        for (member, which) in [(handover.member, String::new())].into_iter().chain(far) {
+            let [count, successes] = &handed_over[member];
+            println!(
+                "  handed over to member {member}{which} in {} episodes ({} of them successes)",
+                count.load(Ordering::Relaxed),
+                successes.load(Ordering::Relaxed)
+            );
+        }
     }
     if start_gesture.is_some() {
         println!(

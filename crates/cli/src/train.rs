@@ -11,7 +11,7 @@ use dexcube_env::{
     ControlRate, CubeRotEnv, EpisodeSettings, GoalLead, LayerOpEnv, StartMix, StartPick,
 };
 use dexcube_rl::checkpoint::CheckpointError;
-use dexcube_rl::handover::Handover;
+use dexcube_rl::handover::{FarHandover, Handover};
 use dexcube_rl::start_gesture::StartGesture;
 use dexcube_rl::start_route::{RoutedEpisodes, StartRoute};
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
@@ -347,9 +347,20 @@ pub struct HandoverArgs {
     /// every episode settles on), before the member acts: letting go and trying again.
     #[arg(long, value_name = "STEPS")]
     let_go: Option<usize>,
+    /// Another member for the stalls whose cube is still --far-beyond or more from its goal
+    /// when the handover comes (session 60); the rest go to --member.
+    #[arg(long, requires = "far_beyond")]
+    far_member: Option<usize>,
+    /// How far from its goal (radians) a stalled cube must be for --far-member to take it.
+    #[arg(long, value_name = "RAD", requires = "far_member", value_parser = far_beyond)]
+    far_beyond: Option<f64>,
     /// Where to write the result (PATH.safetensors and PATH.json).
     #[arg(long)]
     out: PathBuf,
+}
+
+fn far_beyond(text: &str) -> Result<f64, String> {
+    angle_flag("--far-beyond", "", text)
 }
 
 fn handover_progress(text: &str) -> Result<f64, String> {
@@ -358,7 +369,7 @@ fn handover_progress(text: &str) -> Result<f64, String> {
 
 pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
     let command = format!(
-        "dexcube handover {} --member {} --patience {} --progress {}{}{} --out {}",
+        "dexcube handover {} --member {} --patience {} --progress {}{}{}{} --out {}",
         args.policy.display(),
         args.member,
         args.patience,
@@ -369,6 +380,9 @@ pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
         args.let_go
             .map(|n| format!(" --let-go {n}"))
             .unwrap_or_default(),
+        (args.far_member.zip(args.far_beyond))
+            .map(|(k, b)| format!(" --far-member {k} --far-beyond {b}"))
+            .unwrap_or_default(),
         args.out.display()
     );
     let handover = Handover {
@@ -377,6 +391,8 @@ pub fn handover(args: HandoverArgs) -> anyhow::Result<ExitCode> {
         progress: args.progress,
         first: args.first,
         let_go: args.let_go,
+        far: (args.far_member.zip(args.far_beyond))
+            .map(|(member, beyond)| FarHandover { member, beyond }),
     };
     Policy::handing_over(&args.policy, handover, &args.out, &command)?;
     println!(

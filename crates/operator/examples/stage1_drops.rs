@@ -1,9 +1,9 @@
 //! How Stage 1 drops the cube, replayed from the starts the operator recorded
 //! (`dexcube eval --record-starts`): each start runs its 100-step episode with a Stage 1
-//! policy, and the cube's place on the palm is followed step by step. It prints, for each
-//! radius, how many runs let the cube stray that far across the palm from its resting point,
-//! among those that dropped it and those that kept it, and how many steps before the drop the
-//! dropping runs first strayed. With a radius and a step count it also runs the steadying
+//! policy (acting as its card says: goal lead, handover), and the cube's place on the palm is
+//! followed step by step. It prints, for each radius, how many runs let the cube stray that
+//! far across the palm from its resting point, among those that dropped it and those that kept
+//! it, and how many steps before the drop the dropping runs first strayed. With a radius and a step count it also runs the steadying
 //! reflex (`--steady-radius`, `--steady-steps` of `dexcube eval`): the hand holds the neutral
 //! action for that many steps whenever the cube strays past the radius.
 //!
@@ -20,7 +20,7 @@ use dexcube_operator::stages::{
 use dexcube_rl::Policy;
 use dexcube_sim::{Scene, SceneKind};
 
-const RADII: [f64; 3] = [0.03, 0.04, 0.05];
+const RADII: [f64; 4] = [0.02, 0.03, 0.04, 0.05];
 
 /// One replayed start: the first step the cube strayed past each radius, the step it dropped
 /// at, and whether the policy's own success test passed at the episode's end (for a policy
@@ -73,6 +73,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         }
         let (mut observation, _) = env.reset(Some(k as u64));
+        let test = env.goal();
+        // The policy acts as its card says (goal lead, handover), as in `eval-stage`.
+        let mut acting = policy.episode();
         let mut steadier = steadying.map(|s| Steadier::new(s, centre));
         let mut replay = Replay {
             strayed_at: [None; RADII.len()],
@@ -87,7 +90,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             let action = steadied_action(steadier.as_mut(), env.sim(), || {
-                policy.act(&observation.observation, &observation.desired_goal)
+                let achieved = || observation.achieved_goal.clone();
+                let (seen, desired) = (&observation.observation, &observation.desired_goal);
+                acting.act_toward(seen, desired, achieved, test.as_ref())
             });
             let transition = env.step(&action);
             replay.reached = transition.info.is_success;

@@ -497,15 +497,28 @@ impl Policy {
                         .into(),
                 );
             }
-            for member in std::iter::once(handover.member).chain(handover.first) {
+            let far = handover.far.map(|far| far.member);
+            for member in [handover.member]
+                .into_iter()
+                .chain(handover.first)
+                .chain(far)
+            {
                 has_member(members, member)?;
             }
-            if handover.first == Some(handover.member) && !letting_go {
+            if far == Some(handover.member) {
                 return Err(format!(
-                    "member {} would hand over to itself: name another member to act first, \
-                     or let it go first (`--let-go`)",
+                    "member {} takes the far-off stalls and the others alike: name another \
+                     member for the far-off ones, or leave them out",
                     handover.member
                 ));
+            }
+            for member in [handover.member].into_iter().chain(far) {
+                if handover.first == Some(member) && !letting_go {
+                    return Err(format!(
+                        "member {member} would hand over to itself: name another member to \
+                         act first, or let it go first (`--let-go`)"
+                    ));
+                }
             }
             card.handover = Some(handover);
             Ok(())
@@ -770,7 +783,7 @@ impl Acting<'_> {
         });
         match (turn, policy.card.handover) {
             (Turn::LettingGo, _) => vec![0.0; policy.card.dims.action],
-            (Turn::Member, Some(handover)) => act(Some(handover.member), &shown),
+            (Turn::Member(member), _) => act(Some(member), &shown),
             (Turn::Before, Some(handover)) => act(handover.first, &shown),
             _ => act(None, &shown),
         }
@@ -795,6 +808,11 @@ impl Acting<'_> {
 
     /// Whether the episode has been handed to a member.
     pub fn handed_over(&self) -> bool {
-        self.watch.as_ref().is_some_and(HandoverWatch::handed_over)
+        self.handed_to().is_some()
+    }
+
+    /// The member the episode has been handed to, if it has been.
+    pub fn handed_to(&self) -> Option<usize> {
+        self.watch.as_ref().and_then(HandoverWatch::handed_to)
     }
 }

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use dexcube_env::{Goal, GoalEnv, GoalLead, Info, Observation, Spaces, Transition};
-use dexcube_rl::handover::Handover;
+use dexcube_rl::handover::{FarHandover, Handover};
 use dexcube_rl::params::NamedTensor;
 use dexcube_rl::point_mass::{PointGoal, PointMassEnv};
 use dexcube_rl::{Agent, DdpgHerConfig, Policy, TrainOptions, train};
@@ -977,6 +977,7 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
             progress: 0.05,
             first,
             let_go: None,
+            far: None,
         };
         Policy::handing_over(&ensemble, handover, &out, "dexcube handover ...").map(|()| out)
     };
@@ -1031,6 +1032,7 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
             progress: 0.05,
             first: None,
             let_go: Some(2),
+            far: None,
         };
         let out = dir.join(name);
         Policy::handing_over(from, handover, &out, "dexcube handover ...").unwrap();
@@ -1060,6 +1062,28 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
     let mut acting = at_once.episode();
     let action = acting.act_toward(&obs.observation, desired, || achieved.clone(), &test);
     assert_eq!(action, as_member, "a patience of 0 is the member alone");
+    // A far member takes the stalls at least `beyond` from the goal: every stall with 0, none
+    // with a `beyond` past any angle; the rest go to the member.
+    let handing_far = |first: Option<usize>, member: usize, beyond: f64| {
+        let out = dir.join(format!("far{first:?}-{member}-{beyond}"));
+        let far = Some(FarHandover { member, beyond });
+        let handover = Handover {
+            first,
+            far,
+            ..hands.card.handover.unwrap()
+        };
+        Policy::handing_over(&ensemble, handover, &out, "dexcube handover ...").map(|()| out)
+    };
+    for (beyond, member, expected) in [(0.0, 0, &as_first), (1e9, 1, &as_member)] {
+        let policy = Policy::load(&handing_far(None, 0, beyond).unwrap(), &device).unwrap();
+        let mut acting = policy.episode();
+        for step in 1..=4 {
+            let action = acting.act_toward(&obs.observation, desired, || achieved.clone(), &test);
+            let expected = if step < 3 { &as_ensemble } else { expected };
+            assert_eq!(&action, expected, "beyond {beyond}, step {step}");
+        }
+        assert_eq!(acting.handed_to(), Some(member), "beyond {beyond}");
+    }
 
     let refusal = |from: &std::path::Path| {
         let handover = hands.card.handover.unwrap();
@@ -1074,6 +1098,18 @@ fn an_ensemble_hands_a_stalled_episode_to_its_member() {
         (Some(1), 1, "member 1 would hand over to itself"),
     ] {
         let refused = handing_after(first, member, 5).err().unwrap().to_string();
+        assert!(refused.contains(says), "{refused}");
+    }
+    for (first, far, says) in [
+        (None, 2, "2 members (0 to 1), not a member 2"),
+        (
+            None,
+            1,
+            "member 1 takes the far-off stalls and the others alike",
+        ),
+        (Some(0), 0, "member 0 would hand over to itself"),
+    ] {
+        let refused = handing_far(first, far, 0.5).err().unwrap().to_string();
         assert!(refused.contains(says), "{refused}");
     }
 }
