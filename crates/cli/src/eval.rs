@@ -767,6 +767,20 @@ pub struct EvalStageArgs {
     /// the member is handed the cube.
     #[arg(long, value_name = "FILE")]
     record_handovers: Option<PathBuf>,
+    /// Stage 1 only: also record, for every episode whose cube strays more than
+    /// --stray-radius from its goal's position before any handover, the physics state after
+    /// the first such step, and the goal, marked failed where the episode then failed, for
+    /// `train --starts`: where the cube is on its way off the palm (session 60).
+    #[arg(long, value_name = "FILE")]
+    record_strays: Option<PathBuf>,
+    /// How far from its goal's position (metres) a cube has strayed for --record-strays.
+    #[arg(
+        long,
+        default_value_t = 0.05,
+        value_name = "M",
+        requires = "record_strays"
+    )]
+    stray_radius: f64,
     /// Let the policy act every N physics substeps of 2 ms (the paper's 20; fewer is a
     /// faster control rate), with as many more steps to an episode, so that each still
     /// lasts 4 simulated seconds; placements and settling are unchanged. N divides 20.
@@ -905,6 +919,9 @@ struct EpisodeTrace {
     /// Where an ensemble that hands over handed the episode to its member, when asked for;
     /// Stage 1 only, as for `closest`.
     handover: Option<RecordedStart>,
+    /// Where the cube first strayed past the radius asked for, before any handover; Stage 1
+    /// only, as for `closest`.
+    stray: Option<RecordedStart>,
     /// The member an ensemble with a handover handed the episode to, if it did.
     handed_to: Option<usize>,
     /// A policy with a start gesture made it before it first acted.
@@ -922,6 +939,8 @@ struct Keep {
     after_gesture: bool,
     closest: bool,
     handover: bool,
+    /// The radius for `--record-strays`, when asked for.
+    stray: Option<f64>,
 }
 
 /// Runs a deterministic episode from `seed`, keeping what `keep` asks for; `posing` for
@@ -941,7 +960,7 @@ fn episode(
     let (mut hold, mut longest_hold) = (0, 0);
     let (mut steps, mut first_at_goal) = (0, None);
     let (mut closest, mut closest_angle) = (None, f64::INFINITY);
-    let mut handover = None;
+    let (mut handover, mut stray) = (None, None);
     watch(env.sim_mut());
     let test = env.goal();
     let mut acting = policy.episode();
@@ -966,6 +985,14 @@ fn episode(
             0
         };
         longest_hold = longest_hold.max(hold);
+        if let Some(radius) = keep.stray
+            && stray.is_none()
+            && !acting.handed_over()
+            && t.info.position_error > radius
+            && !t.info.dropped
+        {
+            stray = Some(env.fresh_start());
+        }
         if keep.closest && t.info.angle_error < closest_angle {
             closest_angle = t.info.angle_error;
             // Stage 1's goal is the same at every step, so this restores the moment.
@@ -993,6 +1020,7 @@ fn episode(
                 start,
                 closest,
                 handover,
+                stray,
                 handed_to: acting.handed_to(),
                 gestured: acting.gestured(),
                 route: acting.route(),
@@ -1035,6 +1063,7 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
     for (flag, asked) in [
         ("--record-closest", args.record_closest.is_some()),
         ("--record-handovers", args.record_handovers.is_some()),
+        ("--record-strays", args.record_strays.is_some()),
     ] {
         if asked && args.stage != EnvKind::Rot {
             bail!(
@@ -1108,9 +1137,10 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         after_gesture: args.after_gesture,
         closest: args.record_closest.is_some(),
         handover: args.record_handovers.is_some(),
+        stray: args.record_strays.is_some().then_some(args.stray_radius),
     };
     let (recorded, recorded_closest) = (Mutex::new(Vec::new()), Mutex::new(Vec::new()));
-    let recorded_handovers = Mutex::new(Vec::new());
+    let (recorded_handovers, recorded_strays) = (Mutex::new(Vec::new()), Mutex::new(Vec::new()));
     // Episode k begins from recorded start k, or from a fresh placement seeded seed + k.
     let episode_seed = |k: usize| match starts {
         Some(_) => k as u64,
@@ -1162,13 +1192,17 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
                 let mut kept = recorded_closest.lock().expect("no thread panics");
                 kept.push((k, closest));
             }
-            if let Some(handover) = trace.handover {
-                let handover = RecordedStart {
-                    failed: ending != Ending::Success,
-                    ..handover
-                };
-                let mut kept = recorded_handovers.lock().expect("no thread panics");
-                kept.push((k, handover));
+            for (state, kept) in [
+                (trace.handover, &recorded_handovers),
+                (trace.stray, &recorded_strays),
+            ] {
+                if let Some(state) = state {
+                    let state = RecordedStart {
+                        failed: ending != Ending::Success,
+                        ..state
+                    };
+                    kept.lock().expect("no thread panics").push((k, state));
+                }
             }
             if ending == Ending::Success && !trace.square {
                 wins_out_of_square.fetch_add(1, Ordering::Relaxed);
@@ -1393,6 +1427,17 @@ pub fn eval_stage(args: EvalStageArgs) -> anyhow::Result<ExitCode> {
         println!(
             "  recorded where the {} episodes handed over ({failed} of them failed) were handed to the member in {}",
             handovers.len(),
+            path.display()
+        );
+    }
+    if let Some(path) = &args.record_strays {
+        let flag = format!("--stray-radius {} --record-strays", args.stray_radius);
+        let strays = save(&flag, path, recorded_strays)?;
+        let failed = strays.iter().filter(|s| s.failed).count();
+        println!(
+            "  recorded where the {} episodes whose cube strayed more than {} m from its goal's position ({failed} of them failed) first did so in {}",
+            strays.len(),
+            args.stray_radius,
             path.display()
         );
     }
