@@ -778,7 +778,8 @@ pub struct EvalStageArgs {
         long,
         default_value_t = 0.05,
         value_name = "M",
-        requires = "record_strays"
+        requires = "record_strays",
+        value_parser = stray_radius
     )]
     stray_radius: f64,
     /// Let the policy act every N physics substeps of 2 ms (the paper's 20; fewer is a
@@ -928,6 +929,15 @@ struct EpisodeTrace {
     gestured: bool,
     /// Which of a policy's start routes handed the episode to its member, if any.
     route: Option<usize>,
+}
+
+fn stray_radius(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(radius) if radius > 0.0 => Ok(radius),
+        _ => Err(format!(
+            "--stray-radius must be a distance in metres above 0, not '{text}'"
+        )),
+    }
 }
 
 /// What an episode keeps of its physics, for `--record-starts` (where the policy first acts

@@ -1698,6 +1698,80 @@ fn eval_stage_records_where_an_ensemble_hands_over() {
     );
 }
 
+/// `eval-stage --record-strays` keeps, for each Stage 1 episode whose cube strays past the
+/// radius, the state where it first did, marked failed where the episode failed: with a radius
+/// every cube passes at once, every episode; with one no cube reaches, none. Stage 2 and a
+/// radius that is not a positive distance are refused.
+#[test]
+fn eval_stage_records_where_the_cube_strays() {
+    let dir = fresh_dir("dexcube-cli-record-strays");
+    std::fs::create_dir_all(&dir).unwrap();
+    let [rot, layer] = ["rot", "layer"].map(|name| models().join(name));
+    let [rot, layer] = [&rot, &layer].map(|path| path.to_str().unwrap());
+    let file = dir.join("strays.safetensors");
+    let file = file.to_str().unwrap();
+    let run = |radius: &str| {
+        let args = [
+            "rot",
+            "--episodes",
+            "3",
+            "--threads",
+            "2",
+            "--seed",
+            "2000000",
+            "--rot-policy",
+            rot,
+            "--layer-policy",
+            layer,
+            "--record-strays",
+            file,
+            "--stray-radius",
+            radius,
+        ];
+        eval_stage_csv(&dir.join(format!("{radius}.csv")), &args)
+    };
+    let (text, printed) = run("0.0001");
+    let failures = (text.lines().skip(1))
+        .filter(|row| row.split(',').nth(2) != Some("success"))
+        .count();
+    let says = format!(
+        "the 3 episodes whose cube strayed more than 0.0001 m from its goal's position ({failures} of them failed)"
+    );
+    assert!(printed.contains(&says), "{printed}");
+    let (_, printed) = run("1");
+    assert!(
+        printed.contains("the 0 episodes whose cube strayed more than 1 m"),
+        "{printed}"
+    );
+    let refused = |stage: &str, radius: &str| {
+        let args = [
+            "eval-stage",
+            stage,
+            "--episodes",
+            "1",
+            "--rot-policy",
+            rot,
+            "--layer-policy",
+            layer,
+            "--record-strays",
+            file,
+            "--stray-radius",
+            radius,
+        ];
+        dexcube(&args, "")
+    };
+    assert_clean_failure(
+        &refused("layer", "0.05"),
+        2,
+        "--record-strays keeps Stage 1's states",
+    );
+    assert_clean_failure(
+        &refused("rot", "0"),
+        2,
+        "--stray-radius must be a distance in metres above 0",
+    );
+}
+
 /// `goal-lead` writes a policy that `eval-stage` runs shown its goal led on, which a single
 /// episode tells from the policy it was made from; bad settings and combining it are refused.
 #[test]
