@@ -1710,15 +1710,9 @@ fn eval_stage_records_where_the_cube_strays() {
     let [rot, layer] = [&rot, &layer].map(|path| path.to_str().unwrap());
     let file = dir.join("strays.safetensors");
     let file = file.to_str().unwrap();
-    let run = |radius: &str| {
-        let args = [
-            "rot",
-            "--episodes",
-            "3",
-            "--threads",
-            "2",
-            "--seed",
-            "2000000",
+    // The policies and the recording, with the radius.
+    let recording = |radius: &'static str| {
+        [
             "--rot-policy",
             rot,
             "--layer-policy",
@@ -1727,7 +1721,19 @@ fn eval_stage_records_where_the_cube_strays() {
             file,
             "--stray-radius",
             radius,
+        ]
+    };
+    let run = |radius: &'static str| {
+        let fresh = [
+            "rot",
+            "--episodes",
+            "3",
+            "--threads",
+            "2",
+            "--seed",
+            "2000000",
         ];
+        let args = [&fresh[..], &recording(radius)].concat();
         eval_stage_csv(&dir.join(format!("{radius}.csv")), &args)
     };
     let (text, printed) = run("0.0001");
@@ -1743,21 +1749,12 @@ fn eval_stage_records_where_the_cube_strays() {
         printed.contains("the 0 episodes whose cube strayed more than 1 m"),
         "{printed}"
     );
-    let refused = |stage: &str, radius: &str| {
+    let refused = |stage: &str, radius: &'static str| {
         let args = [
-            "eval-stage",
-            stage,
-            "--episodes",
-            "1",
-            "--rot-policy",
-            rot,
-            "--layer-policy",
-            layer,
-            "--record-strays",
-            file,
-            "--stray-radius",
-            radius,
-        ];
+            &["eval-stage", stage, "--episodes", "1"][..],
+            &recording(radius),
+        ]
+        .concat();
         dexcube(&args, "")
     };
     assert_clean_failure(

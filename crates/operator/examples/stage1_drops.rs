@@ -3,9 +3,10 @@
 //! policy (acting as its card says: goal lead, handover), and the cube's place on the palm is
 //! followed step by step. It prints, for each radius, how many runs let the cube stray that
 //! far across the palm from its resting point, among those that dropped it and those that kept
-//! it, and how many steps before the drop the dropping runs first strayed. With a radius and a step count it also runs the steadying
-//! reflex (`--steady-radius`, `--steady-steps` of `dexcube eval`): the hand holds the neutral
-//! action for that many steps whenever the cube strays past the radius.
+//! it, and how many steps before the drop the dropping runs first strayed. With a radius and a
+//! step count it also runs the steadying reflex (`--steady-radius`, `--steady-steps` of
+//! `dexcube eval`): the hand holds the neutral action for that many steps whenever the cube
+//! strays past the radius.
 //!
 //! `cargo run --release -p dexcube-operator --example stage1_drops -- STARTS [RADIUS STEPS]
 //! [--dropped-only] [--policy PREFIX]` (policy default `models/rot`, judged in pair mode).

@@ -1024,9 +1024,9 @@ fn a_start_gesture_comes_first_only_towards_the_fingertips() {
 /// (which comes first, as the card says); and the episodes that make the gesture with the cube
 /// near square to the hand to another, after the gesture. The test reads the yaw from the
 /// cube's free joint, not from the policy's view as the route does (the two differ by the
-/// cube's misalignment, which matters only within it of the threshold). Every other episode acts as the ensemble does. A second
-/// route of a kind, a near-square route without a gesture, a single policy and a member it
-/// lacks are refused.
+/// cube's misalignment, which matters only within it of the threshold). Every other episode
+/// acts as the ensemble does. A second route of a kind, a near-square route without a
+/// gesture, a single policy and a member it lacks are refused.
 #[test]
 fn start_routes_hand_the_thumbs_side_and_near_square_gestures_to_their_members() {
     let (stages, resting) = shipped_stages();

@@ -498,10 +498,9 @@ impl Policy {
                 );
             }
             let far = handover.far.map(|far| far.member);
-            for member in [handover.member]
+            for member in [Some(handover.member), handover.first, far]
                 .into_iter()
-                .chain(handover.first)
-                .chain(far)
+                .flatten()
             {
                 has_member(members, member)?;
             }
@@ -512,13 +511,16 @@ impl Policy {
                     handover.member
                 ));
             }
-            for member in [handover.member].into_iter().chain(far) {
-                if handover.first == Some(member) && !letting_go {
-                    return Err(format!(
-                        "member {member} would hand over to itself: name another member to \
-                         act first, or let it go first (`--let-go`)"
-                    ));
-                }
+            // The members a stall may be handed to; the one acting first is not among them.
+            let handed_to = |member| member == handover.member || far == Some(member);
+            if let Some(first) = handover
+                .first
+                .filter(|&first| handed_to(first) && !letting_go)
+            {
+                return Err(format!(
+                    "member {first} would hand over to itself: name another member to act \
+                     first, or let it go first (`--let-go`)"
+                ));
             }
             card.handover = Some(handover);
             Ok(())
