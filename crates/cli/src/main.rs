@@ -58,6 +58,9 @@ enum Command {
     /// their mean can turn it neither). Writes a policy that loads and runs as any other; its
     /// weights are unchanged.
     Handover(train::HandoverArgs),
+    /// Ships a residual trained on top of a policy (`train --residual-of`) with that policy as
+    /// one: it acts as the base, with the residual's correction added to each action.
+    Residual(train::ResidualArgs),
     /// Lets a policy begin with a gesture where the cube starts towards the fingertips: for
     /// its first few steps, some actuators take a fixed action and the rest the neutral one,
     /// then the policy acts (Stage 2 mends most of its failures on that side of the palm with
@@ -104,6 +107,7 @@ fn main() -> ExitCode {
         Command::Guide(args) => train::guide(args),
         Command::GoalLead(args) => train::goal_lead(args),
         Command::Handover(args) => train::handover(args),
+        Command::Residual(args) => train::residual(args),
         Command::StartGesture(args) => train::start_gesture(args),
         Command::StartRoute(args) => train::start_route(args),
         Command::Distil(args) => distil::run(args),

@@ -3,15 +3,17 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use anyhow::bail;
 use clap::Args;
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{
-    ControlRate, CubeRotEnv, EpisodeSettings, GoalLead, LayerOpEnv, StartMix, StartPick,
+    ControlRate, CubeRotEnv, EpisodeSettings, GoalEnv, GoalLead, LayerOpEnv, StartMix, StartPick,
 };
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::handover::{FarHandover, Handover};
+use dexcube_rl::residual::{ResidualEnv, ResidualSetting, check_scale};
 use dexcube_rl::start_gesture::StartGesture;
 use dexcube_rl::start_route::{RoutedEpisodes, StartRoute};
 use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
@@ -135,6 +137,24 @@ pub struct TrainArgs {
     /// resume must say it again.
     #[arg(long, default_value_t = 0.0, value_name = "S", value_parser = physics_spread)]
     physics_spread: f64,
+    /// Train a residual on top of this policy (residual policy learning: any card, e.g.
+    /// models/rot-lead-handover, acting as it is deployed) rather than a policy of its own:
+    /// the actor observes the observation followed by the base's action, its action times
+    /// --residual-scale is added to the base's, and it starts at zero, so the run first acts
+    /// as the base. `dexcube residual` ships the base and a snapshot as one policy. The
+    /// environment (view, success test) must be the one the base was trained on. A resume
+    /// must say it again.
+    #[arg(long, value_name = "PREFIX", conflicts_with_all = ["init", "init_actor"])]
+    residual_of: Option<PathBuf>,
+    /// With --residual-of, the share of the action range the residual may move the base's
+    /// action by.
+    #[arg(
+        long,
+        default_value_t = 0.1,
+        value_name = "S",
+        requires = "residual_of"
+    )]
+    residual_scale: f64,
 }
 
 /// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
@@ -317,6 +337,37 @@ pub fn goal_lead(args: GoalLeadArgs) -> anyhow::Result<ExitCode> {
         args.policy.display(),
         args.share,
         args.within,
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct ResidualArgs {
+    /// The base, the policy the residual was trained on top of (`train --residual-of`), as
+    /// the path of its .safetensors and .json less the extension.
+    base: PathBuf,
+    /// The residual's actor: a snapshot (or the best or last policy) of that run.
+    actor: PathBuf,
+    /// Where to write the result (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Ships a residual with its base as one policy, acting as the base with the residual's
+/// correction added.
+pub fn residual(args: ResidualArgs) -> anyhow::Result<ExitCode> {
+    let command = format!(
+        "dexcube residual {} {} --out {}",
+        args.base.display(),
+        args.actor.display(),
+        args.out.display()
+    );
+    Policy::with_residual(&args.base, &args.actor, &args.out, &command)?;
+    println!(
+        "{} with the residual {} into {}",
+        args.base.display(),
+        args.actor.display(),
         args.out.display()
     );
     Ok(ExitCode::SUCCESS)
@@ -568,6 +619,20 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
             args.choice.control_rate
         );
     }
+    let begun_residual = environment.get("residual").filter(|r| !r.is_null());
+    let now_residual = residual_setting(args);
+    if begun_residual != now_residual.as_ref() {
+        let said = |setting: Option<&serde_json::Value>| match setting {
+            Some(r) => format!("--residual-of {} --residual-scale {}", r["of"], r["scale"]),
+            None => "no --residual-of".to_string(),
+        };
+        bail!(
+            "{} began with {}; resume it with the same, not {}",
+            run.display(),
+            said(begun_residual),
+            said(now_residual.as_ref())
+        );
+    }
     // Runs from before physics could be varied ran on the scene's own, and runs from before
     // the threshold could be chosen trained to the paper's.
     for (key, flag, given, before) in [
@@ -593,6 +658,38 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
         }
     }
     Ok(())
+}
+
+/// The residual a run trains, as its metadata records it; none for a policy of its own.
+fn residual_setting(args: &TrainArgs) -> Option<serde_json::Value> {
+    args.residual_of.as_ref().map(|of| {
+        serde_json::json!(ResidualSetting {
+            of: of.clone(),
+            scale: args.residual_scale,
+        })
+    })
+}
+
+/// Trains on the environments `make` makes, or with `residual` (the base and the scale) on
+/// top of the base acting in them.
+fn train_on<E: GoalEnv + 'static>(
+    make: impl Fn() -> E,
+    residual: Option<(Arc<Policy>, f64)>,
+    config: DdpgHerConfig,
+    options: &TrainOptions,
+) -> anyhow::Result<dexcube_rl::train::Trained> {
+    let Some((base, scale)) = residual else {
+        return Ok(train(make, config, options)?);
+    };
+    // Checked once here, so that every environment after it is made alike.
+    if let Err(message) = ResidualEnv::new(make(), base.clone(), scale) {
+        bail!("cannot train a residual: {message}");
+    }
+    let wrapped = || {
+        ResidualEnv::new(make(), base.clone(), scale)
+            .unwrap_or_else(|message| unreachable!("checked above: {message}"))
+    };
+    Ok(train(wrapped, config, options)?)
 }
 
 pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
@@ -652,6 +749,11 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             String::new()
         } else {
             format!("-sub{rate}")
+        }
+        + if args.residual_of.is_some() {
+            "-residual"
+        } else {
+            ""
         };
     let name = args.choice.env.name();
     let (out, resume) = match (&args.out, &args.resume) {
@@ -720,6 +822,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         init_actor: args.init_actor.clone(),
         snapshot_every: args.snapshot_every,
         critic_only_epochs: args.critic_only_epochs,
+        zero_output: args.residual_of.is_some(),
         progress: true,
         label: args.choice.name()?,
         metadata: serde_json::json!({
@@ -745,6 +848,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
             "control_substeps": rate.substeps(),
             "physics_spread": args.physics_spread,
             "angle_threshold": args.choice.angle_threshold,
+            "residual": residual_setting(&args),
         }),
     };
     eprintln!(
@@ -769,6 +873,16 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         physics_spread: args.physics_spread,
         ..EpisodeSettings::PAPER
     };
+    if let Err(message) = check_scale(args.residual_scale) {
+        bail!("--residual-scale: {message}");
+    }
+    let residual = match &args.residual_of {
+        Some(base) => Some((
+            Arc::new(Policy::load(base, &burn::prelude::Device::flex())?),
+            args.residual_scale,
+        )),
+        None => None,
+    };
     let trained = match args.choice.env {
         EnvKind::Rot => {
             let goal = args.choice.rot_goal()?;
@@ -778,7 +892,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_starts(starts.clone())
                     .with_settings(settings)
             };
-            train(make, config, &options)?
+            train_on(make, residual, config, &options)?
         }
         EnvKind::Layer => {
             let (layer_move, goal) = (args.choice.layer_move, args.choice.layer_goal()?);
@@ -794,7 +908,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
                     .with_starts(starts.clone())
                     .with_settings(settings)
             };
-            train(make, config, &options)?
+            train_on(make, residual, config, &options)?
         }
     };
     let best = trained

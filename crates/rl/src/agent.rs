@@ -397,6 +397,23 @@ impl Agent {
         Ok(())
     }
 
+    /// Sets the actor's output layer (and its target's) to zero, weights and bias, so that it
+    /// acts with zero until it learns otherwise: a residual's start.
+    pub fn zero_output(&mut self) {
+        let mut networks = self.networks();
+        for actor in [0, 2] {
+            let layers = &mut networks[actor];
+            let last = layers.iter().filter_map(|t| layer_index(&t.name)).max();
+            for tensor in layers.iter_mut() {
+                if layer_index(&tensor.name) == last {
+                    tensor.values.iter_mut().for_each(|v| *v = 0.0);
+                }
+            }
+        }
+        self.load_networks(&networks)
+            .expect("the agent's own networks fit it");
+    }
+
     /// The actor's parameters: what a shipped policy holds.
     pub fn actor_params(&self) -> Vec<params::NamedTensor> {
         params::read(&self.actor.valid())
@@ -449,6 +466,15 @@ impl Agent {
         twin.target = params::write(twin.target.clone(), &saved[1], replace)?;
         Ok(())
     }
+}
+
+/// The layer a parameter named `layers.{i}.…` belongs to.
+fn layer_index(name: &str) -> Option<usize> {
+    name.strip_prefix("layers.")?
+        .split('.')
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// A one-element tensor's value (NaN if it has none).

@@ -19,6 +19,8 @@
 //!   starts towards the fingertips;
 //! - [`start_route`]: ensemble members that act alone in the episodes picked by where the
 //!   cube starts (towards the thumb, or near square where the start gesture is made);
+//! - [`residual`]: a correction learned on top of a fixed policy that works (residual policy
+//!   learning), and the environment that trains it;
 //! - [`distil`]: one actor fitted to act as another policy (an ensemble) does, by DAgger;
 //! - [`point_mass`]: a small reaching task that proves the learner in seconds.
 //!
@@ -38,6 +40,7 @@ pub mod plot;
 pub mod point_mass;
 pub mod policy;
 pub mod replay;
+pub mod residual;
 pub mod rollout;
 pub mod seeds;
 pub mod start_file;

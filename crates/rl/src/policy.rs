@@ -25,6 +25,7 @@ use crate::handover::{Handover, HandoverWatch, Turn};
 use crate::networks::Mlp;
 use crate::normalizer::Normalizer;
 use crate::params::{self, NamedTensor};
+use crate::residual::{ResidualSetting, check_scale, residual_action};
 use crate::start_gesture::StartGesture;
 use crate::start_route::StartRoute;
 
@@ -59,6 +60,19 @@ pub struct PolicyCard {
     /// winning; none for the paper's.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub start_routes: Vec<StartRoute>,
+    /// A correction trained on top of the policy as the rest of the card makes it act
+    /// ([`crate::residual`]); none for the paper's. Its weights are the tensors named
+    /// `residual.…`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residual: Option<ResidualCard>,
+}
+
+/// A residual on a policy's card: its actor's sizes and normalisers (it observes the
+/// policy's observation followed by the base's action), and how it joins the base.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ResidualCard {
+    pub actor: PartnerCard,
+    pub scale: f64,
 }
 
 /// One more member of an ensemble: the sizes of its actor and the normalisers it was trained
@@ -81,8 +95,13 @@ pub struct Policy {
     partners: Vec<Mlp>,
     /// A run's critics choosing among actions near the actor's, when guided.
     guide: Option<CriticGuide>,
+    /// The residual's actor, when the card has one.
+    residual: Option<Mlp>,
     pub(crate) device: Device,
 }
+
+/// The tensor-name prefix of a residual's actor.
+const RESIDUAL_PREFIX: &str = "residual.";
 
 /// The tensor-name prefix of an ensemble's `i`-th partner.
 fn partner_prefix(i: usize) -> String {
@@ -130,6 +149,7 @@ fn restated(
     change: impl FnOnce(&mut PolicyCard) -> Result<(), String>,
 ) -> Result<(), CheckpointError> {
     let (weights, mut card, tensors) = read_stored(policy)?;
+    refuse_residual(&weights, &card, "changed")?;
     change(&mut card).map_err(|message| CheckpointError::Refused {
         path: weights,
         message,
@@ -146,6 +166,7 @@ pub(crate) fn read_single(
     used: &str,
 ) -> Result<(PathBuf, PolicyCard, Vec<NamedTensor>), CheckpointError> {
     let (weights, card, tensors) = read_stored(prefix)?;
+    refuse_residual(&weights, &card, used)?;
     if let Some(lead) = &card.goal_lead {
         return Err(mismatch(
             &weights,
@@ -188,6 +209,22 @@ pub(crate) fn read_single(
     ))
 }
 
+/// Refuses a policy with a residual, which was trained on top of the card as it is and so
+/// cannot be `used` ("changed", "joined", "guided").
+fn refuse_residual(weights: &Path, card: &PolicyCard, used: &str) -> Result<(), CheckpointError> {
+    match &card.residual {
+        Some(_) => Err(mismatch(
+            weights,
+            format!(
+                "it acts with a residual trained on top of it as it is, and cannot be {used}: \
+                 use its base (its card's metadata.residual_of names it), and train a residual \
+                 on top of whatever is made from that"
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 impl PolicyCard {
     /// The card of the policy at `prefix`, without its weights.
     pub fn read(prefix: &Path) -> Result<PolicyCard, CheckpointError> {
@@ -220,6 +257,13 @@ impl PolicyCard {
         }
         if let Some(handover) = &self.handover {
             settings.insert("handover".into(), serde_json::json!(handover));
+        }
+        if let Some(residual) = &self.residual {
+            let source = &residual.actor.source;
+            settings.insert(
+                "residual".into(),
+                serde_json::json!({"scale": residual.scale, "actor": source}),
+            );
         }
         if let Some(gesture) = &self.start_gesture {
             settings.insert("start_gesture".into(), serde_json::json!(gesture));
@@ -276,6 +320,7 @@ impl Policy {
             handover: None,
             start_gesture: None,
             start_routes: Vec::new(),
+            residual: None,
         };
         let actor = agent.actor_params();
         for prefix in prefixes {
@@ -421,6 +466,7 @@ impl Policy {
         command: &str,
     ) -> Result<(), CheckpointError> {
         let (weights, card, mut tensors) = read_stored(policy)?;
+        refuse_residual(&weights, &card, "guided")?;
         if card.guide.is_some() {
             return Err(mismatch(
                 &weights,
@@ -582,6 +628,72 @@ impl Policy {
         })
     }
 
+    /// Writes at `out` the policy at `base` (any: single, ensemble, led, handing over, with
+    /// gestures and routes) with the residual actor at `actor` on top of it
+    /// ([`crate::residual`]); the base's weights are unchanged. The actor must come from a run
+    /// trained on top of a policy with the base's sizes (its card's metadata.environment says so, and at
+    /// which scale), observing the base's observation followed by its action. The card records
+    /// both and `command`, the command that made it.
+    pub fn with_residual(
+        base: &Path,
+        actor: &Path,
+        out: &Path,
+        command: &str,
+    ) -> Result<(), CheckpointError> {
+        let (base_weights, card, mut tensors) = read_stored(base)?;
+        refuse_residual(&base_weights, &card, "the base of another")?;
+        let (weights, actor_card, actor_tensors) = read_single(actor, "a residual")?;
+        let setting: ResidualSetting =
+            serde_json::from_value(actor_card.metadata["environment"]["residual"].clone())
+                .map_err(|_| {
+                    mismatch(
+                        &weights,
+                        "it was not trained as a residual (its card's metadata.environment has no \
+                     residual: train one with `dexcube train --residual-of BASE`)"
+                            .to_string(),
+                    )
+                })?;
+        check_scale(setting.scale).map_err(|message| mismatch(&weights, message))?;
+        let (dims, needed) = (actor_card.dims, card.dims);
+        if (dims.observation, dims.goal, dims.action)
+            != (
+                needed.observation + needed.action,
+                needed.goal,
+                needed.action,
+            )
+        {
+            return Err(mismatch(
+                &weights,
+                format!(
+                    "its sizes {dims:?} do not fit a residual on {} ({needed:?}): it observes \
+                     the base's observation followed by its action, toward the base's goal",
+                    base.display()
+                ),
+            ));
+        }
+        tensors.extend(params::prefixed(actor_tensors, RESIDUAL_PREFIX));
+        let how = format!(
+            "with the residual {} at scale {}",
+            actor.display(),
+            setting.scale
+        );
+        let card = PolicyCard {
+            metadata: derived_metadata(&card, how, ("residual_of", base), command),
+            residual: Some(ResidualCard {
+                actor: PartnerCard {
+                    dims,
+                    hidden: actor_card.config.hidden,
+                    observation_norm: actor_card.observation_norm,
+                    goal_norm: actor_card.goal_norm,
+                    source: actor.to_path_buf(),
+                },
+                scale: setting.scale,
+            }),
+            ..card
+        };
+        store(out, &tensors, &card)
+    }
+
     /// Loads the policy at `prefix` onto `device`.
     pub fn load(prefix: &Path, device: &Device) -> Result<Policy, CheckpointError> {
         let (weights, card, tensors) = read_stored(prefix)?;
@@ -605,11 +717,20 @@ impl Policy {
             .as_ref()
             .map(|g| CriticGuide::build(g, card.dims, &tensors, &weights, device))
             .transpose()?;
+        let residual = card
+            .residual
+            .as_ref()
+            .map(|residual| {
+                let own = params::under_prefix(&tensors, RESIDUAL_PREFIX);
+                build(residual.actor.dims, &residual.actor.hidden, &own)
+            })
+            .transpose()?;
         Ok(Policy {
             card,
             actor,
             partners,
             guide,
+            residual,
             device: device.clone(),
         })
     }
@@ -632,11 +753,13 @@ impl Policy {
                 handover: None,
                 start_gesture: None,
                 start_routes: Vec::new(),
+                residual: None,
                 ..self.card.clone()
             },
             actor,
             partners: Vec::new(),
             guide: None,
+            residual: None,
             device: self.device.clone(),
         }
     }
@@ -662,12 +785,18 @@ impl Policy {
     /// The policy acting through one episode, as its card says: shown its goal led on, and
     /// handing over when stalled, where it says so.
     pub fn episode(&self) -> Acting<'_> {
+        self.resume(EpisodeMemory {
+            watch: self.card.handover.map(HandoverWatch::new),
+            ..EpisodeMemory::default()
+        })
+    }
+
+    /// The policy acting on through an episode whose memory `memory` was kept apart
+    /// ([`Acting::into_memory`]), as an environment that holds the policy does.
+    pub fn resume(&self, memory: EpisodeMemory) -> Acting<'_> {
         Acting {
             policy: self,
-            watch: self.card.handover.map(HandoverWatch::new),
-            steps: 0,
-            gesture: None,
-            route: None,
+            memory,
         }
     }
 
@@ -699,6 +828,18 @@ impl Policy {
                 (&self.partners[k - 1], norms.0, norms.1)
             }
         };
+        self.actor_action(actor, (observation_norm, goal_norm), observation, goal)
+    }
+
+    /// `actor`'s deterministic action for one observation and goal, read through `norms`
+    /// (observation, goal).
+    fn actor_action(
+        &self,
+        actor: &Mlp,
+        (observation_norm, goal_norm): (&Normalizer, &Normalizer),
+        observation: &[f64],
+        goal: &[f64],
+    ) -> Vec<f64> {
         let x = network_inputs(
             observation_norm,
             goal_norm,
@@ -710,11 +851,36 @@ impl Policy {
         let out = actor.forward(x).tanh().into_data().convert::<f64>();
         out.try_to_vec::<f64>().unwrap_or_default()
     }
+
+    /// `base`, the card's action without its residual, with the residual's correction added
+    /// where the card has one: the residual observes `observation` followed by `base`, toward
+    /// `desired` (the goal itself, as in training, not one led on).
+    fn with_residual_action(
+        &self,
+        observation: &[f64],
+        desired: &[f64],
+        base: Vec<f64>,
+    ) -> Vec<f64> {
+        let (Some(actor), Some(card)) = (&self.residual, &self.card.residual) else {
+            return base;
+        };
+        let seen: Vec<f64> = observation.iter().chain(&base).copied().collect();
+        let norms = (&card.actor.observation_norm, &card.actor.goal_norm);
+        let correction = self.actor_action(actor, norms, &seen, desired);
+        residual_action(&base, &correction, card.scale)
+    }
 }
 
-/// A policy acting through one episode ([`Policy::episode`]): what its handover watches of it.
+/// A policy acting through one episode ([`Policy::episode`]).
 pub struct Acting<'a> {
     policy: &'a Policy,
+    memory: EpisodeMemory,
+}
+
+/// What a policy keeps of one episode: what its handover watches, the steps acted, and what
+/// the first step decided.
+#[derive(Default)]
+pub struct EpisodeMemory {
     watch: Option<HandoverWatch>,
     /// Control steps acted so far.
     steps: usize,
@@ -727,13 +893,32 @@ pub struct Acting<'a> {
 }
 
 impl Acting<'_> {
+    /// The episode's memory, to act on later through [`Policy::resume`].
+    pub fn into_memory(self) -> EpisodeMemory {
+        self.memory
+    }
+
     /// The deterministic action toward `desired` for one observation, judged by `test`: the
     /// start gesture's for its first steps where the card has one and the cube started towards
     /// the fingertips; then shown the goal led on where the card says so, from the object's
     /// goal now, and by the member handed over to once the episode has stalled, where it says
     /// so, or throughout by the member of the start route that took the episode, or else of
     /// the gesture, where either names one; `achieved` reads the object's goal only for these.
+    /// A residual on the card, if any, adds its correction to that action
+    /// ([`crate::residual`]).
     pub fn act_toward(
+        &mut self,
+        observation: &[f64],
+        desired: &[f64],
+        achieved: impl FnOnce() -> Vec<f64>,
+        test: &dyn Goal,
+    ) -> Vec<f64> {
+        let base = self.base_toward(observation, desired, achieved, test);
+        self.policy.with_residual_action(observation, desired, base)
+    }
+
+    /// The action as the card says without its residual: what a residual was trained on top of.
+    fn base_toward(
         &mut self,
         observation: &[f64],
         desired: &[f64],
@@ -742,37 +927,37 @@ impl Acting<'_> {
     ) -> Vec<f64> {
         let policy = self.policy;
         let card = &policy.card;
-        if self.steps == 0 {
+        if self.memory.steps == 0 {
             // The first step: where the cube starts decides the gesture and the route.
             let gesture = card.start_gesture.as_ref();
-            self.gesture = gesture
+            self.memory.gesture = gesture
                 .filter(|gesture| gesture.applies(observation))
                 .map(|gesture| gesture.action(card.dims.action));
-            let gestured = self.gesture.is_some();
-            self.route =
+            let gestured = self.memory.gesture.is_some();
+            self.memory.route =
                 (card.start_routes.iter()).position(|route| route.applies(observation, gestured));
         }
-        self.steps += 1;
-        if let (Some(action), Some(gesture)) = (&self.gesture, &card.start_gesture)
-            && self.steps <= gesture.steps
+        self.memory.steps += 1;
+        if let (Some(action), Some(gesture)) = (&self.memory.gesture, &card.start_gesture)
+            && self.memory.steps <= gesture.steps
         {
             return action.clone();
         }
         // A specialist member acts alone, before and after any handover, in the episodes a
         // start route took or that made the gesture; otherwise the member the turn names, or
         // all of them.
-        let routed = self.route.map(|k| card.start_routes[k].member);
+        let routed = self.memory.route.map(|k| card.start_routes[k].member);
         let gesture_member = card
             .start_gesture
             .as_ref()
             .and_then(|gesture| gesture.member);
-        let specialist = routed.or(self.gesture.as_ref().and(gesture_member));
+        let specialist = routed.or(self.memory.gesture.as_ref().and(gesture_member));
         let act = |member: Option<usize>, goal: &[f64]| match specialist.or(member) {
             Some(member) => policy.member_action(member, observation, goal),
             None => policy.act(observation, goal),
         };
         let lead = policy.card.goal_lead;
-        if lead.is_none() && self.watch.is_none() {
+        if lead.is_none() && self.memory.watch.is_none() {
             return act(None, desired);
         }
         let now = achieved();
@@ -780,7 +965,7 @@ impl Acting<'_> {
             Some(lead) => test.led(&now, desired, lead),
             None => desired.to_vec(),
         };
-        let turn = self.watch.as_mut().map_or(Turn::Before, |watch| {
+        let turn = self.memory.watch.as_mut().map_or(Turn::Before, |watch| {
             watch.turn(|| (test.errors(&now, desired).1, test.is_success(&now, desired)))
         });
         match (turn, policy.card.handover) {
@@ -793,19 +978,19 @@ impl Acting<'_> {
 
     /// Which of the card's start routes took the episode to its member, if any.
     pub fn route(&self) -> Option<usize> {
-        self.route
+        self.memory.route
     }
 
     /// Whether the episode began with the start gesture.
     pub fn gestured(&self) -> bool {
-        self.gesture.is_some()
+        self.memory.gesture.is_some()
     }
 
     /// Whether the action last given was the start gesture's last: the policy itself acts
     /// next, from the state that action leads to.
     pub fn gesture_just_made(&self) -> bool {
         self.gestured()
-            && self.policy.card.start_gesture.as_ref().map(|g| g.steps) == Some(self.steps)
+            && self.policy.card.start_gesture.as_ref().map(|g| g.steps) == Some(self.memory.steps)
     }
 
     /// Whether the episode has been handed to a member.
@@ -815,6 +1000,9 @@ impl Acting<'_> {
 
     /// The member the episode has been handed to, if it has been.
     pub fn handed_to(&self) -> Option<usize> {
-        self.watch.as_ref().and_then(HandoverWatch::handed_to)
+        self.memory
+            .watch
+            .as_ref()
+            .and_then(HandoverWatch::handed_to)
     }
 }

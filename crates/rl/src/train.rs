@@ -66,6 +66,10 @@ pub struct TrainOptions {
     /// a few episodes can lose what it knew (0: none, DDPG as published). A resumed run keeps
     /// the number its first call gave.
     pub critic_only_epochs: usize,
+    /// Start the actor (and its target) with a zero output layer, so that it first acts with
+    /// zero: a residual's start, which acts as its base ([`crate::residual`]). A fresh run's
+    /// only: a warm start brings an actor of its own.
+    pub zero_output: bool,
     /// Show a progress bar with ETA on stderr.
     pub progress: bool,
     /// What is being trained, for plots and policy cards.
@@ -89,6 +93,7 @@ impl TrainOptions {
             init_actor: None,
             snapshot_every: 0,
             critic_only_epochs: 0,
+            zero_output: false,
             progress: false,
             label: label.into(),
             metadata: serde_json::json!({}),
@@ -296,6 +301,14 @@ pub fn train<E: GoalEnv>(
     };
     let (mut metrics, start) = resumed.unwrap_or_else(|| (Vec::new(), RunStart::of(options)));
     if metrics.is_empty() {
+        let warm = options.init_from.is_some() || options.init_actor.is_some();
+        if options.zero_output && warm {
+            return Err(TrainError::WarmStart(
+                "a zero output starts a fresh actor, and a warm start brings one: leave out one \
+                 or the other"
+                    .into(),
+            ));
+        }
         match (&options.init_from, &options.init_actor) {
             (Some(dir), actor_from) => warm_start(&mut agent, dir, actor_from.as_deref())?,
             (None, Some(prefix)) => warm_start_actor(&mut agent, prefix)?,
@@ -307,6 +320,9 @@ pub fn train<E: GoalEnv>(
                 ));
             }
             (None, None) => {}
+        }
+        if options.zero_output {
+            agent.zero_output();
         }
         if config.anchor > 0.0 {
             agent.set_anchor_here();

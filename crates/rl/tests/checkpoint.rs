@@ -9,15 +9,8 @@ use dexcube_rl::params::NamedTensor;
 use dexcube_rl::point_mass::{PointGoal, PointMassEnv};
 use dexcube_rl::{Agent, DdpgHerConfig, Policy, TrainOptions, train};
 
-fn config() -> DdpgHerConfig {
-    DdpgHerConfig {
-        hidden: vec![32, 32],
-        cycles_per_epoch: 3,
-        batches_per_cycle: 5,
-        test_episodes: 4,
-        ..DdpgHerConfig::default()
-    }
-}
+mod common;
+use common::{config, fresh_dir};
 
 fn options(dir: &std::path::Path, epochs: usize, resume: bool) -> TrainOptions {
     TrainOptions {
@@ -56,12 +49,6 @@ fn load_error(prefix: &std::path::Path) -> String {
         Ok(_) => panic!("{} loaded", prefix.display()),
         Err(e) => e.to_string(),
     }
-}
-
-fn fresh_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
 }
 
 /// A one-epoch point-mass run of a smaller network (one hidden layer of 8), in a fresh folder.
