@@ -674,6 +674,29 @@ fn train_refuses_settings_it_cannot_run() {
             ],
             "cannot warm-start: the policy",
         ),
+        // The shipped Stage 1 sees the cube's misalignment; this environment does not.
+        (
+            &[
+                "rot",
+                "--mode",
+                "pair",
+                "--object",
+                "cube",
+                "--square",
+                "--residual-of",
+                concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/rot"),
+            ],
+            "cannot train a residual: the base policy takes",
+        ),
+        (
+            &["rot", "--residual-of", "models/rot", "--residual-scale", "0"],
+            "--residual-scale: a residual's scale must be above 0 and at most 1",
+        ),
+        (&["rot", "--residual-scale", "0.2"], "--residual-of <PREFIX>"),
+        (
+            &["rot", "--residual-of", "models/rot", "--init-actor", "models/rot"],
+            "cannot be used with",
+        ),
     ] {
         let o = dexcube(
             &[&["train"][..], args, &["--out", "/nonexistent/run"]].concat(),
@@ -681,6 +704,11 @@ fn train_refuses_settings_it_cannot_run() {
         );
         assert_clean_failure(&o, 2, says);
     }
+    // Shipping a residual: an actor not trained as one is refused.
+    let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../models");
+    let (base, actor) = (format!("{models}/rot"), format!("{models}/rot-td3-19"));
+    let o = dexcube(&["residual", &base, &actor, "--out", "/nonexistent/r"], "");
+    assert_clean_failure(&o, 2, "it was not trained as a residual");
 }
 
 /// A policy of either stage warm-started onto a view beyond the paper's gains its inputs
