@@ -689,12 +689,27 @@ fn train_refuses_settings_it_cannot_run() {
             "cannot train a residual: the base policy takes",
         ),
         (
-            &["rot", "--residual-of", "models/rot", "--residual-scale", "0"],
+            &[
+                "rot",
+                "--residual-of",
+                "models/rot",
+                "--residual-scale",
+                "0",
+            ],
             "--residual-scale: a residual's scale must be above 0 and at most 1",
         ),
-        (&["rot", "--residual-scale", "0.2"], "--residual-of <PREFIX>"),
         (
-            &["rot", "--residual-of", "models/rot", "--init-actor", "models/rot"],
+            &["rot", "--residual-scale", "0.2"],
+            "--residual-of <PREFIX>",
+        ),
+        (
+            &[
+                "rot",
+                "--residual-of",
+                "models/rot",
+                "--init-actor",
+                "models/rot",
+            ],
             "cannot be used with",
         ),
     ] {

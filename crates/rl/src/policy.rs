@@ -631,9 +631,9 @@ impl Policy {
     /// Writes at `out` the policy at `base` (any: single, ensemble, led, handing over, with
     /// gestures and routes) with the residual actor at `actor` on top of it
     /// ([`crate::residual`]); the base's weights are unchanged. The actor must come from a run
-    /// trained on top of a policy with the base's sizes (its card's metadata.environment says so, and at
-    /// which scale), observing the base's observation followed by its action. The card records
-    /// both and `command`, the command that made it.
+    /// trained on top of a policy with the base's sizes (its card's `metadata.environment`
+    /// says so, and at which scale), observing the base's observation followed by its action.
+    /// The card records both and `command`, the command that made it.
     pub fn with_residual(
         base: &Path,
         actor: &Path,
@@ -648,8 +648,8 @@ impl Policy {
                 .map_err(|_| {
                     mismatch(
                         &weights,
-                        "it was not trained as a residual (its card's metadata.environment has no \
-                     residual: train one with `dexcube train --residual-of BASE`)"
+                        "it was not trained as a residual (its card's metadata.environment \
+                         has no residual: train one with `dexcube train --residual-of BASE`)"
                             .to_string(),
                     )
                 })?;
