@@ -619,18 +619,24 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
             args.choice.control_rate
         );
     }
-    let begun_residual = environment.get("residual").filter(|r| !r.is_null());
+    // Runs from before residuals could be trained trained policies of their own.
+    let begun_residual: Option<ResidualSetting> =
+        serde_json::from_value(environment["residual"].clone()).unwrap_or(None);
     let now_residual = residual_setting(args);
-    if begun_residual != now_residual.as_ref() {
-        let said = |setting: Option<&serde_json::Value>| match setting {
-            Some(r) => format!("--residual-of {} --residual-scale {}", r["of"], r["scale"]),
+    if begun_residual != now_residual {
+        let said = |setting: Option<ResidualSetting>| match setting {
+            Some(r) => format!(
+                "--residual-of {} --residual-scale {}",
+                r.of.display(),
+                r.scale
+            ),
             None => "no --residual-of".to_string(),
         };
         bail!(
             "{} began with {}; resume it with the same, not {}",
             run.display(),
             said(begun_residual),
-            said(now_residual.as_ref())
+            said(now_residual)
         );
     }
     // Runs from before physics could be varied ran on the scene's own, and runs from before
@@ -660,13 +666,11 @@ fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> 
     Ok(())
 }
 
-/// The residual a run trains, as its metadata records it; none for a policy of its own.
-fn residual_setting(args: &TrainArgs) -> Option<serde_json::Value> {
-    args.residual_of.as_ref().map(|of| {
-        serde_json::json!(ResidualSetting {
-            of: of.clone(),
-            scale: args.residual_scale,
-        })
+/// The residual a run trains; none for a policy of its own.
+fn residual_setting(args: &TrainArgs) -> Option<ResidualSetting> {
+    args.residual_of.as_ref().map(|of| ResidualSetting {
+        of: of.clone(),
+        scale: args.residual_scale,
     })
 }
 

@@ -720,9 +720,9 @@ fn train_refuses_settings_it_cannot_run() {
         assert_clean_failure(&o, 2, says);
     }
     // Shipping a residual: an actor not trained as one is refused.
-    let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../models");
-    let (base, actor) = (format!("{models}/rot"), format!("{models}/rot-td3-19"));
-    let o = dexcube(&["residual", &base, &actor, "--out", "/nonexistent/r"], "");
+    let [base, actor] = ["rot", "rot-td3-19"].map(|name| models().join(name));
+    let [base, actor] = [&base, &actor].map(|path| path.to_str().unwrap());
+    let o = dexcube(&["residual", base, actor, "--out", "/nonexistent/r"], "");
     assert_clean_failure(&o, 2, "it was not trained as a residual");
 }
 
@@ -1632,7 +1632,6 @@ fn an_ensemble_handing_over_runs_as_its_member_once_handed_over() {
 #[test]
 fn a_policy_letting_go_takes_the_neutral_action_then_tries_again() {
     let dir = fresh_dir("dexcube-cli-let-go");
-    std::fs::create_dir_all(&dir).unwrap();
     let [rot, layer] = ["rot", "layer"].map(|name| models().join(name));
     let [rot, layer] = [&rot, &layer].map(|path| path.to_str().unwrap());
     let letting_go = |patience: &str, steps: &str| {
@@ -1748,7 +1747,6 @@ fn eval_stage_records_where_an_ensemble_hands_over() {
 #[test]
 fn eval_stage_records_where_the_cube_strays() {
     let dir = fresh_dir("dexcube-cli-record-strays");
-    std::fs::create_dir_all(&dir).unwrap();
     let [rot, layer] = ["rot", "layer"].map(|name| models().join(name));
     let [rot, layer] = [&rot, &layer].map(|path| path.to_str().unwrap());
     let file = dir.join("strays.safetensors");

@@ -85,8 +85,9 @@ impl<E: GoalEnv> ResidualEnv<E> {
             );
         }
         let goal = env.goal();
+        // The episode's memory and the base's first action come with the first reset.
         Ok(ResidualEnv {
-            memory: base.episode().into_memory(),
+            memory: EpisodeMemory::default(),
             env,
             base,
             scale,
