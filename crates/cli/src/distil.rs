@@ -114,6 +114,14 @@ pub fn run(args: DistilArgs) -> anyhow::Result<ExitCode> {
             setup.prefix.display()
         );
     }
+    if teacher.card.nearest_frame {
+        bail!(
+            "{} is shown the cube in the frame nearest its goal, which the student, labelled \
+             by its members' actions step by step, would not be: distil the policy it was made \
+             from (its card's metadata.nearest_frame names it)",
+            setup.prefix.display()
+        );
+    }
     if teacher.card.handover.is_some() {
         bail!(
             "{} hands stalled episodes to a member, which a student labelled step by step \

@@ -52,6 +52,12 @@ enum Command {
     /// term adds to an error that persists. Writes a policy that loads and runs as any other;
     /// its weights are unchanged.
     GoalLead(train::GoalLeadArgs),
+    /// Shows a Stage 1 policy the cube in the frame nearest its goal: of the cube's rotations
+    /// onto itself that its test cannot tell apart (in pair mode, the turns about the target's
+    /// up axis and the flips), the one that leaves the cube's whole orientation nearest the
+    /// goal's, at every step. Writes a policy that loads and runs as any other; its weights are
+    /// unchanged.
+    NearestFrame(train::NearestFrameArgs),
     /// Lets an ensemble hand a stalled episode to one of its members: once the cube has gone
     /// some steps neither meeting its test nor coming nearer its goal, that member acts alone
     /// for the rest of the episode (where the members would turn the cube different ways,
@@ -106,6 +112,7 @@ fn main() -> ExitCode {
         Command::Ensemble(args) => train::combine(train::Combination::Ensemble, args),
         Command::Guide(args) => train::guide(args),
         Command::GoalLead(args) => train::goal_lead(args),
+        Command::NearestFrame(args) => train::nearest_frame(args),
         Command::Handover(args) => train::handover(args),
         Command::Residual(args) => train::residual(args),
         Command::StartGesture(args) => train::start_gesture(args),

@@ -343,6 +343,31 @@ pub fn goal_lead(args: GoalLeadArgs) -> anyhow::Result<ExitCode> {
 }
 
 #[derive(Args)]
+pub struct NearestFrameArgs {
+    /// The policy (any but one with a residual), as the path of its .safetensors and .json
+    /// less the extension.
+    policy: PathBuf,
+    /// Where to write the result (PATH.safetensors and PATH.json).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn nearest_frame(args: NearestFrameArgs) -> anyhow::Result<ExitCode> {
+    let command = format!(
+        "dexcube nearest-frame {} --out {}",
+        args.policy.display(),
+        args.out.display()
+    );
+    Policy::in_nearest_frame(&args.policy, &args.out, &command)?;
+    println!(
+        "{} shown the cube in the frame nearest its goal into {}",
+        args.policy.display(),
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
 pub struct ResidualArgs {
     /// The base, the policy the residual was trained on top of (`train --residual-of`), as
     /// the path of its .safetensors and .json less the extension.

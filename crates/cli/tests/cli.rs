@@ -1851,6 +1851,65 @@ fn a_policy_led_on_runs_on_the_goal_led_on() {
     assert_clean_failure(&joined, 2, "shown its goal led on (by 0.5 within 0.5 rad)");
 }
 
+/// `nearest-frame` writes a Stage 1 policy that `eval-stage` runs shown the cube in the frame
+/// nearest its goal, which a single episode tells from the policy it was made from; a Stage 2
+/// policy, a second relabelling and distilling it are refused cleanly.
+#[test]
+fn a_stage_1_policy_runs_in_the_frame_nearest_its_goal() {
+    let dir = fresh_dir("dexcube-cli-nearest-frame");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (rot, layer) = (models().join("rot"), models().join("layer"));
+    let (rot, layer) = (rot.to_str().unwrap(), layer.to_str().unwrap());
+    let nearest = dir.join("rot-nearest");
+    let nearest = nearest.to_str().unwrap();
+    let o = dexcube(&["nearest-frame", rot, "--out", nearest], "");
+    assert!(
+        o.status.success() && stdout(&o).contains("shown the cube in the frame nearest its goal"),
+        "{}",
+        stderr(&o)
+    );
+    let row = |policy: &str| {
+        let args = [
+            &[
+                "rot",
+                "--episodes",
+                "1",
+                "--threads",
+                "1",
+                "--seed",
+                "2000000",
+            ][..],
+            &["--rot-policy", policy, "--layer-policy", layer],
+        ]
+        .concat();
+        eval_stage_csv(&dir.join("episodes.csv"), &args).0
+    };
+    assert_ne!(
+        row(rot),
+        row(nearest),
+        "the same placement, acted otherwise"
+    );
+    let refused = dir.join("refused");
+    let refused = refused.to_str().unwrap();
+    for (policy, says) in [
+        (layer, "not a pose (Stage 1's 7 or 8)"),
+        (nearest, "in the frame nearest its goal already"),
+    ] {
+        let o = dexcube(&["nearest-frame", policy, "--out", refused], "");
+        assert_clean_failure(&o, 2, says);
+    }
+    let distil = [
+        &["distil", "rot", "--rot-policy", nearest][..],
+        &["--layer-policy", layer, "--out", refused],
+    ]
+    .concat();
+    assert_clean_failure(
+        &dexcube(&distil, ""),
+        2,
+        "shown the cube in the frame nearest its goal",
+    );
+}
+
 /// `start-gesture --member 1` on an ensemble of `layer` and another Stage 2, handing over with
 /// `--first 0 --member 0 --let-go 10`, acts episode for episode as the other policy with the
 /// same handover and gesture where the gesture is made, and as `layer` with them elsewhere

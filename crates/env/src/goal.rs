@@ -6,8 +6,10 @@
 use std::f64::consts::PI;
 
 use dexcube_sim::cube::ALIGNED_TOLERANCE;
-use dexcube_sim::rotation;
+use dexcube_sim::rotation::{self, Quat};
 use serde::{Deserialize, Serialize};
+
+use crate::hand_object::relabelled;
 
 /// A goal space: its size, the success test, and the errors `info` reports.
 pub trait Goal: Send + Sync {
@@ -32,6 +34,15 @@ pub trait Goal: Send + Sync {
     /// is now `achieved`. A goal space with no way on shows `desired` as it is.
     fn led(&self, _achieved: &[f64], desired: &[f64], _lead: GoalLead) -> Vec<f64> {
         desired.to_vec()
+    }
+
+    /// Where this test reads the object alike in more than one frame (a cube's rotations onto
+    /// itself that it cannot tell apart), the one that brings the achieved orientation nearest
+    /// `desired`'s: the rotation `g` whose relabelling reads an orientation q as q·g
+    /// ([`crate::in_object_frame`] reads an observation so), and `achieved` read in that
+    /// frame. None (the default) where the test reads the object in one frame only.
+    fn nearest_frame(&self, _achieved: &[f64], _desired: &[f64]) -> Option<(Quat, Vec<f64>)> {
+        None
     }
 }
 
@@ -235,6 +246,32 @@ impl Goal for RotGoal {
             goal[k] += lead.share * (desired[k] - achieved[k]);
         }
         goal
+    }
+
+    /// The cube's rotations onto itself that keep the target's up axis where the test reads
+    /// it: about that axis in axis mode (4), and the flips too in pair mode (8). The paper's
+    /// test reads the whole orientation, so it has none but the identity.
+    fn nearest_frame(&self, achieved: &[f64], desired: &[f64]) -> Option<(Quat, Vec<f64>)> {
+        let (a, d) = (quat(achieved), quat(desired));
+        let up = rotation::rotate(&rotation::conj(&d), [0.0, 0.0, 1.0]);
+        let keeps_up = |g: &Quat| {
+            let along: f64 = (rotation::rotate(g, up).iter().zip(up))
+                .map(|(x, y)| x * y)
+                .sum();
+            match self.mode {
+                RotMode::Paper => false,
+                RotMode::Axis => along > 0.99,
+                RotMode::Pair => along.abs() > 0.99,
+            }
+        };
+        let off = |g: &Quat| rotation::angle_between(&rotation::mul(&a, g), &d);
+        // The identity comes first, so a tie keeps the frame the object is read in.
+        let g = (rotation::cube_rotations().into_iter())
+            .filter(keeps_up)
+            .min_by(|g, h| off(g).total_cmp(&off(h)))?;
+        let mut reached = achieved.to_vec();
+        reached[3..POSE_GOAL].copy_from_slice(&relabelled(&a, &g));
+        Some((g, reached))
     }
 }
 

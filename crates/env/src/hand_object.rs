@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState};
-use dexcube_sim::rotation::Quat;
+use dexcube_sim::rotation::{self, Quat};
 use dexcube_sim::{
     GRIP_PARTS, HAND_ACTUATORS, HAND_JOINTS, PhysicsScales, Pose, Scene, SceneKind, Sim,
 };
@@ -415,4 +415,25 @@ fn settle(sim: &mut Sim) -> bool {
 /// The same rotation with a non-negative real part.
 pub fn canonical(q: Quat) -> Quat {
     if q[0] < 0.0 { q.map(|x| -x) } else { q }
+}
+
+/// Orientation `q` read in the object's frame relabelled by `g`, a rotation of the object onto
+/// itself: q·g, with w ≥ 0.
+pub fn relabelled(q: &Quat, g: &Quat) -> Quat {
+    canonical(rotation::normalise(&rotation::mul(q, g)))
+}
+
+/// An observation of the object (the 61 shared ones first) read in its frame relabelled by
+/// `g` ([`Goal::nearest_frame`]): the orientation q·g, and the angular velocity, which is in
+/// the object's frame, turned by g⁻¹; the rest, world-frame or the frame's own, is the same.
+pub fn in_object_frame(observation: &[f64], g: &Quat) -> Vec<f64> {
+    let orientation = OBJECT_POSITION + 3;
+    let angular = OBJECT_POSITION + 10;
+    let mut seen = observation.to_vec();
+    let q = &observation[orientation..orientation + 4];
+    seen[orientation..orientation + 4].copy_from_slice(&relabelled(&[q[0], q[1], q[2], q[3]], g));
+    let w = &observation[angular..angular + 3];
+    let turned = rotation::rotate(&rotation::conj(g), [w[0], w[1], w[2]]);
+    seen[angular..angular + 3].copy_from_slice(&turned);
+    seen
 }

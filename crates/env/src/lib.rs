@@ -35,7 +35,7 @@ pub use dexcube_sim::SimError;
 pub use goal::{Goal, GoalLead, LayerGoal, RotGoal, RotMode};
 pub use hand_object::{
     BASE_OBSERVATION, DROP_DEPTH, EpisodeSettings, OBJECT_POSITION, ObjectKind, SETTLE_STEPS, View,
-    base_observation, is_dropped, is_square, resting_point, set_down,
+    base_observation, in_object_frame, is_dropped, is_square, resting_point, set_down,
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, achieved_goal, cube_misalignment, pose_goal, rot_observation};

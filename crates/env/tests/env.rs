@@ -1,17 +1,18 @@
 //! The goal-env contract of CubeRotEnv and LayerOpEnv, with real physics.
 
 use dexcube_env::layer::LayerGoals;
+use dexcube_env::random::uniform_rotation;
 use dexcube_env::rot::PAPER_TARGETS;
 use dexcube_env::{
     ControlRate, CubeLayer, CubeRotEnv, EpisodeSettings, Goal, GoalEnv, GoalLead, LayerGoal,
     LayerMove, LayerOpEnv, OBJECT_POSITION, ObjectKind, RecordedStart, RotGoal, RotMode,
-    SimulatedEnv, StartMix, StartPick, VecEnv, View, pose_goal,
+    SimulatedEnv, StartMix, StartPick, VecEnv, View, in_object_frame, pose_goal,
 };
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
 use dexcube_cube::Face;
 use dexcube_sim::cube::{ALIGNED_TOLERANCE, CubeState, face_toward, turn_face_by};
-use dexcube_sim::rotation::{self, about};
+use dexcube_sim::rotation::{self, Quat, about};
 use dexcube_sim::{Pose, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -211,6 +212,105 @@ fn a_goal_led_on_lies_further_on_by_its_share_of_the_error() {
         layer.led(&[0.9, 0.0], &[FRAC_PI_2, 0.0], lead),
         [FRAC_PI_2, 0.0]
     );
+}
+
+/// Of the cube's rotations onto itself, the nearest frame chooses among those the test reads
+/// alike (in pair mode the turns about the target's up axis and the flips, in axis mode the
+/// turns, in the paper's none), found here by the test's own errors, the one that leaves the
+/// whole orientation nearest the goal's; the test reads the pose there as it did.
+#[test]
+fn the_nearest_frame_reads_the_pose_alike_and_nearest_the_goal() {
+    let mut rng = ChaCha8Rng::seed_from_u64(62);
+    for (mode, frames) in [(RotMode::Pair, 8), (RotMode::Axis, 4)] {
+        let test = RotGoal::paper(mode).left_square();
+        let mut relabelled = 0;
+        for case in 0..200 {
+            let now = uniform_rotation(&mut rng);
+            let at = |q: Quat| test.achieved(&pose_goal([0.01, -0.004, 0.003], q), 0.03);
+            let achieved = at(now);
+            let desired = test.desired(&pose_goal([0.0; 3], PAPER_TARGETS[case % 3]));
+            let errors = test.errors(&achieved, &desired);
+            let alike: Vec<Quat> = (rotation::cube_rotations().into_iter())
+                .filter(|g| {
+                    let there = test.errors(&at(rotation::mul(&now, g)), &desired);
+                    (there.0 - errors.0).abs() < 1e-12 && (there.1 - errors.1).abs() < 1e-9
+                })
+                .collect();
+            assert_eq!(alike.len(), frames, "{mode:?}");
+            let (g, reached) = test.nearest_frame(&achieved, &desired).unwrap();
+            assert!(alike.contains(&g), "{mode:?}: {g:?}");
+            let quat = |goal: &[f64]| [goal[3], goal[4], goal[5], goal[6]];
+            let target = quat(&desired);
+            assert!(reached[3] >= 0.0);
+            assert!(rotation::angle_between(&quat(&reached), &rotation::mul(&now, &g)) < 1e-6);
+            let off = rotation::angle_between(&quat(&reached), &target);
+            for h in &alike {
+                let other = rotation::angle_between(&rotation::mul(&now, h), &target);
+                assert!(
+                    off <= other + 1e-7,
+                    "{mode:?}: {off} from the goal, {other} in another frame"
+                );
+            }
+            let (position, angle) = test.errors(&reached, &desired);
+            assert!((position - errors.0).abs() < 1e-12 && (angle - errors.1).abs() < 1e-9);
+            assert_eq!(
+                test.is_success(&reached, &desired),
+                test.is_success(&achieved, &desired)
+            );
+            assert_eq!(reached[7], achieved[7], "the misalignment stays");
+            relabelled += usize::from(g != rotation::IDENTITY);
+        }
+        assert!(
+            relabelled > 100,
+            "{mode:?}: {relabelled} of 200 read in another frame"
+        );
+    }
+    let paper = RotGoal::paper(RotMode::Paper);
+    let (achieved, desired) = at_angle(&paper, 0.3);
+    assert_eq!(paper.nearest_frame(&achieved, &desired), None);
+    assert_eq!(
+        LayerGoal::square().nearest_frame(&[1.3, 0.2], &[FRAC_PI_2, 0.0]),
+        None
+    );
+}
+
+/// An observation read in another frame of the cube has the orientation q·g (w ≥ 0) and the
+/// same angular velocity in the world (the observation's is in the cube's frame); the rest
+/// is unchanged.
+#[test]
+fn an_observation_read_in_another_frame_keeps_the_cubes_motion() {
+    let mut rng = ChaCha8Rng::seed_from_u64(63);
+    let frames = rotation::cube_rotations();
+    for case in 0..50 {
+        let mut observation: Vec<f64> = (0..62).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let q = uniform_rotation(&mut rng);
+        let (orientation, angular) = (OBJECT_POSITION + 3, OBJECT_POSITION + 10);
+        observation[orientation..orientation + 4].copy_from_slice(&q);
+        let g = frames[case % 24];
+        let seen = in_object_frame(&observation, &g);
+        let part = |v: &[f64], at: usize| [v[at], v[at + 1], v[at + 2]];
+        let seen_q = [
+            seen[orientation],
+            seen[orientation + 1],
+            seen[orientation + 2],
+            seen[orientation + 3],
+        ];
+        assert!(seen_q[0] >= 0.0);
+        assert!(rotation::angle_between(&seen_q, &rotation::mul(&q, &g)) < 1e-6);
+        let world = rotation::rotate(&q, part(&observation, angular));
+        let seen_world = rotation::rotate(&seen_q, part(&seen, angular));
+        assert!(
+            world
+                .iter()
+                .zip(seen_world)
+                .all(|(a, b)| (a - b).abs() < 1e-12)
+        );
+        for k in (0..62).filter(|k| {
+            !(orientation..angular + 3).contains(k) || (orientation + 4..angular).contains(k)
+        }) {
+            assert_eq!(seen[k], observation[k], "entry {k}");
+        }
+    }
 }
 
 /// An achieved and a desired pose `angle` apart by a tilt about x, as `test` has them.

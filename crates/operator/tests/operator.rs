@@ -6,8 +6,8 @@ use dexcube_cube::Face;
 use dexcube_cube::{CostTable, DistanceTable, Solver, scrambles_at_distance};
 use dexcube_env::layer::{LayerGoals, LayerMove};
 use dexcube_env::{
-    ControlRate, CubeRotEnv, EPISODE_STEPS, GoalEnv, LayerOpEnv, OBJECT_POSITION, ObjectKind,
-    RotGoal, RotMode, SimulatedEnv, StartMix, StartPick,
+    ControlRate, CubeRotEnv, EPISODE_STEPS, Goal, GoalEnv, LayerOpEnv, OBJECT_POSITION, ObjectKind,
+    RotGoal, RotMode, SimulatedEnv, StartMix, StartPick, in_object_frame,
 };
 use dexcube_operator::stages::{
     Driving, KinematicStage1, KinematicStage2, OPENING_STEPS, RecordingStage1, RecordingStage2,
@@ -918,6 +918,58 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     );
     stages.stage1.policy.card.metadata["environment"]["control_substeps"] = 3.into();
     assert!(card_rate(&stages).is_err());
+}
+
+/// A Stage 1 policy shown the cube in the frame nearest its goal acts, from every placement,
+/// as the policy it was made from does on the observation and the cube's goal read in that
+/// frame (here at its first step, where a policy with no lead or handover reads the goal
+/// itself), and from some placements differently from it. A second relabelling, a Stage 2
+/// policy, and joining it into an ensemble are refused.
+#[test]
+fn a_stage_1_policy_in_the_nearest_frame_acts_as_its_policy_on_the_cube_read_there() {
+    let (stages, _) = shipped_stages();
+    let device = burn::prelude::Device::flex();
+    let dir = std::env::temp_dir().join(format!("dexcube-nearest-frame-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let out = dir.join("rot-nearest");
+    Policy::in_nearest_frame(&models.join("rot"), &out, "test").unwrap();
+    let nearest = Policy::load(&out, &device).unwrap();
+    assert!(nearest.card.nearest_frame);
+    let (plain, test) = (&stages.stage1.policy, stages.stage1.goal);
+    let scene = Scene::load(SceneKind::Cube).unwrap();
+    let mut env = CubeRotEnv::with_scene(scene, test).with_view(stages.stage1.view);
+    let mut relabelled = 0;
+    for seed in 0..8 {
+        let (obs, _) = env.reset(Some(seed));
+        let (achieved, desired) = (&obs.achieved_goal, &obs.desired_goal);
+        let (g, _) = test.nearest_frame(achieved, desired).unwrap();
+        let acted =
+            (nearest.episode()).act_toward(&obs.observation, desired, || achieved.clone(), &test);
+        assert_eq!(
+            acted,
+            plain.act(&in_object_frame(&obs.observation, &g), desired)
+        );
+        if g != rotation::IDENTITY {
+            relabelled += 1;
+            assert_ne!(acted, plain.act(&obs.observation, desired), "seed {seed}");
+        }
+    }
+    assert!(relabelled > 0, "some placement is read in another frame");
+    let err = |result: Result<(), dexcube_rl::checkpoint::CheckpointError>| {
+        result.err().unwrap().to_string()
+    };
+    let again = Policy::in_nearest_frame(&out, &dir.join("x"), "test");
+    assert!(err(again).contains("frame nearest its goal already"));
+    let layer = Policy::in_nearest_frame(&models.join("layer"), &dir.join("x"), "test");
+    assert!(err(layer).contains("not a pose (Stage 1's 7 or 8)"));
+    let joined = Policy::ensemble(
+        &[out.clone(), models.join("rot-td3-19")],
+        &dir.join("x"),
+        "test",
+    );
+    assert!(err(joined).contains("shown the cube in the frame nearest its goal and cannot be"));
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The four fingers' knuckles held straight for 2 steps where the cube starts with y below

@@ -8,13 +8,16 @@
 //! mean of its members' deterministic actions.
 //!
 //! A policy may be shown its goal led on ([`Policy::led`], [`GoalLead`]), and an ensemble may
-//! hand a stalled episode to one member ([`Policy::handing_over`], [`Handover`]): its card
-//! says how, and whoever runs it acts through [`Policy::episode`], which applies both.
+//! hand a stalled episode to one member ([`Policy::handing_over`], [`Handover`]); a Stage 1
+//! policy may be shown the cube in the frame nearest its goal ([`Policy::in_nearest_frame`]).
+//! Its card says how, and whoever runs it acts through [`Policy::episode`], which applies them.
 
+use std::borrow::Cow;
+use std::cell::LazyCell;
 use std::path::{Path, PathBuf};
 
 use burn::prelude::*;
-use dexcube_env::{Goal, GoalLead};
+use dexcube_env::{Goal, GoalLead, RotGoal, RotMode, in_object_frame};
 use serde::{Deserialize, Serialize};
 
 use crate::agent::{Agent, Dims, network_inputs};
@@ -48,6 +51,11 @@ pub struct PolicyCard {
     /// paper's, which is shown its goal as it is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub goal_lead: Option<GoalLead>,
+    /// Whether the policy is shown the cube in the frame nearest its goal among those its
+    /// test reads alike ([`Goal::nearest_frame`]); not for the paper's, which is shown the
+    /// frame the cube is read in.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub nearest_frame: bool,
     /// The member an ensemble hands a stalled episode to, and when; none for the paper's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub handover: Option<Handover>,
@@ -177,6 +185,15 @@ pub(crate) fn read_single(
             ),
         ));
     }
+    if card.nearest_frame {
+        return Err(mismatch(
+            &weights,
+            format!(
+                "it is shown the cube in the frame nearest its goal and cannot be {used}: use \
+                 the policy it was made from (its card's metadata.nearest_frame names it)"
+            ),
+        ));
+    }
     if let Some(gesture) = &card.start_gesture {
         return Err(mismatch(
             &weights,
@@ -255,6 +272,9 @@ impl PolicyCard {
         if let Some(lead) = &self.goal_lead {
             settings.insert("goal_lead".into(), serde_json::json!(lead));
         }
+        if self.nearest_frame {
+            settings.insert("nearest_frame".into(), serde_json::json!(true));
+        }
         if let Some(handover) = &self.handover {
             settings.insert("handover".into(), serde_json::json!(handover));
         }
@@ -317,6 +337,7 @@ impl Policy {
             partners: Vec::new(),
             guide: None,
             goal_lead: None,
+            nearest_frame: false,
             handover: None,
             start_gesture: None,
             start_routes: Vec::new(),
@@ -512,6 +533,33 @@ impl Policy {
                 return Err("its goal is led on already: lead the policy it was made from".into());
             }
             card.goal_lead = Some(lead);
+            Ok(())
+        })
+    }
+
+    /// Writes at `out` the policy at `policy` (any but one with a residual) shown the cube in
+    /// the frame nearest its goal at every step ([`Goal::nearest_frame`]); its weights are
+    /// unchanged. The card records the policy and `command`, the command that made it.
+    pub fn in_nearest_frame(
+        policy: &Path,
+        out: &Path,
+        command: &str,
+    ) -> Result<(), CheckpointError> {
+        let how = "shown the cube in the frame nearest its goal".to_string();
+        restated(policy, (out, command), ("nearest_frame", how), |card| {
+            if card.nearest_frame {
+                let already = "it is shown the cube in the frame nearest its goal already";
+                return Err(already.into());
+            }
+            if RotGoal::of_size(RotMode::Pair, card.dims.goal).is_none() {
+                return Err(format!(
+                    "its goals have {} numbers, not a pose (Stage 1's 7 or 8): only Stage 1's \
+                     test reads the cube alike in more than one frame (Stage 2 already reads \
+                     the layer that stays in the frame nearest upright)",
+                    card.dims.goal
+                ));
+            }
+            card.nearest_frame = true;
             Ok(())
         })
     }
@@ -750,6 +798,7 @@ impl Policy {
                 partners: Vec::new(),
                 guide: None,
                 goal_lead: None,
+                nearest_frame: false,
                 handover: None,
                 start_gesture: None,
                 start_routes: Vec::new(),
@@ -943,6 +992,16 @@ impl Acting<'_> {
         {
             return action.clone();
         }
+        // Shown the cube in the frame nearest its goal, every member reads the observation and
+        // the cube's goal now in that frame; the test reads them alike in either.
+        let read = LazyCell::new(achieved);
+        let frame = (card.nearest_frame)
+            .then(|| test.nearest_frame(&read, desired))
+            .flatten();
+        let observation = match &frame {
+            Some((g, _)) => Cow::Owned(in_object_frame(observation, g)),
+            None => Cow::Borrowed(observation),
+        };
         // A specialist member acts alone, before and after any handover, in the episodes a
         // start route took or that made the gesture; otherwise the member the turn names, or
         // all of them.
@@ -952,58 +1011,31 @@ impl Acting<'_> {
             .as_ref()
             .and_then(|gesture| gesture.member);
         let specialist = routed.or(self.memory.gesture.as_ref().and(gesture_member));
-        let act = |member: Option<usize>, observation: &[f64], goal: &[f64]| match specialist
-            .or(member)
-        {
-            Some(member) => policy.member_action(member, observation, goal),
-            None => policy.act(observation, goal),
+        let act = |member: Option<usize>, goal: &[f64]| match specialist.or(member) {
+            Some(member) => policy.member_action(member, &observation, goal),
+            None => policy.act(&observation, goal),
         };
         let lead = policy.card.goal_lead;
-        let relabelings = prototype_relabelings(observation, desired);
-        if lead.is_none() && self.memory.watch.is_none() && relabelings.is_none() {
-            return act(None, observation, desired);
+        if lead.is_none() && self.memory.watch.is_none() {
+            return act(None, desired);
         }
-        let now = achieved();
+        let now = match &frame {
+            Some((_, reached)) => reached.as_slice(),
+            None => read.as_slice(),
+        };
+        let shown = match lead {
+            Some(lead) => test.led(now, desired, lead),
+            None => desired.to_vec(),
+        };
         let turn = self.memory.watch.as_mut().map_or(Turn::Before, |watch| {
-            watch.turn(|| (test.errors(&now, desired).1, test.is_success(&now, desired)))
+            watch.turn(|| (test.errors(now, desired).1, test.is_success(now, desired)))
         });
-        let member = match (turn, policy.card.handover) {
-            (Turn::LettingGo, _) => return vec![0.0; policy.card.dims.action],
-            (Turn::Member(member), _) => Some(member),
-            (Turn::Before, Some(handover)) => handover.first,
-            _ => None,
-        };
-        let one = |observation: &[f64], now: &[f64]| {
-            let shown = match lead {
-                Some(lead) => test.led(now, desired, lead),
-                None => desired.to_vec(),
-            };
-            act(member, observation, &shown)
-        };
-        if let (Turn::Member(_), Some(k)) = (
-            turn,
-            std::env::var("DEXCUBE_SYM_HANDOVER").ok().and_then(|k| k.parse::<usize>().ok()),
-        ) {
-            let g = prototype_stabiliser(desired)[k];
-            let who = std::env::var("DEXCUBE_SYM_WHO").unwrap_or_default();
-            let (seen, reached) = prototype_relabel(observation, &now, &g);
-            let shown = match lead {
-                Some(lead) => test.led(&reached, desired, lead),
-                None => desired.to_vec(),
-            };
-            return act(if who == "ens" { None } else { member }, &seen, &shown);
+        match (turn, policy.card.handover) {
+            (Turn::LettingGo, _) => vec![0.0; policy.card.dims.action],
+            (Turn::Member(member), _) => act(Some(member), &shown),
+            (Turn::Before, Some(handover)) => act(handover.first, &shown),
+            _ => act(None, &shown),
         }
-        let Some(relabelings) = relabelings else {
-            return one(observation, &now);
-        };
-        let mut total = vec![0.0; policy.card.dims.action];
-        for g in &relabelings {
-            let (seen, reached) = prototype_relabel(observation, &now, g);
-            let action = one(&seen, &reached);
-            total.iter_mut().zip(action).for_each(|(t, a)| *t += a);
-        }
-        total.iter_mut().for_each(|t| *t /= relabelings.len() as f64);
-        total
     }
 
     /// Which of the card's start routes took the episode to its member, if any.
@@ -1035,82 +1067,4 @@ impl Acting<'_> {
             .as_ref()
             .and_then(HandoverWatch::handed_to)
     }
-}
-
-/// PROTOTYPE (DEXCUBE_SYM=4|8): the cube's rotations that keep the target's up axis on its
-/// line (4: about it; 8: and the flips), for a Stage 1 observation and goal.
-fn prototype_relabelings(
-    observation: &[f64],
-    desired: &[f64],
-) -> Option<Vec<dexcube_sim::rotation::Quat>> {
-    use dexcube_sim::rotation;
-    let mode = std::env::var("DEXCUBE_SYM").ok()?;
-    if !(7..=8).contains(&desired.len()) || observation.len() < 61 {
-        return None;
-    }
-    let d = [desired[3], desired[4], desired[5], desired[6]];
-    if mode == "near" {
-        let q = [observation[51], observation[52], observation[53], observation[54]];
-        let nearest = prototype_stabiliser(desired).into_iter().min_by(|a, b| {
-            let ea = rotation::angle_between(&rotation::mul(&q, a), &d);
-            let eb = rotation::angle_between(&rotation::mul(&q, b), &d);
-            ea.total_cmp(&eb)
-        })?;
-        return Some(vec![nearest]);
-    }
-    let size: usize = mode.parse().ok()?;
-    let up = rotation::rotate(&rotation::conj(&d), [0.0, 0.0, 1.0]);
-    let kept: Vec<_> = rotation::cube_rotations()
-        .into_iter()
-        .filter(|g| {
-            let moved = rotation::rotate(g, up);
-            let dot: f64 = moved.iter().zip(up).map(|(a, b)| a * b).sum();
-            match size {
-                1 => g[0] > 0.99,
-                4 => dot > 0.99,
-                _ => dot.abs() > 0.99,
-            }
-        })
-        .collect();
-    match std::env::var("DEXCUBE_SYM_ONLY").ok().and_then(|k| k.parse::<usize>().ok()) {
-        Some(k) => Some(vec![kept[k]]),
-        None => Some(kept),
-    }
-}
-
-/// PROTOTYPE: the observation and achieved goal with the cube's frame relabelled by `g`
-/// (orientation q·g, body angular velocity turned by g⁻¹).
-fn prototype_relabel(
-    observation: &[f64],
-    achieved: &[f64],
-    g: &dexcube_sim::rotation::Quat,
-) -> (Vec<f64>, Vec<f64>) {
-    use dexcube_sim::rotation;
-    let relabel = |q: &[f64]| {
-        let q = rotation::mul(&[q[0], q[1], q[2], q[3]], g);
-        let q = rotation::normalise(&q);
-        if q[0] < 0.0 { q.map(|x| -x) } else { q }
-    };
-    let mut seen = observation.to_vec();
-    seen[51..55].copy_from_slice(&relabel(&observation[51..55]));
-    let w = [observation[58], observation[59], observation[60]];
-    seen[58..61].copy_from_slice(&rotation::rotate(&rotation::conj(g), w));
-    let mut reached = achieved.to_vec();
-    reached[3..7].copy_from_slice(&relabel(&achieved[3..7]));
-    (seen, reached)
-}
-
-/// PROTOTYPE: the 8 cube rotations keeping the target's up axis on its line.
-fn prototype_stabiliser(desired: &[f64]) -> Vec<dexcube_sim::rotation::Quat> {
-    use dexcube_sim::rotation;
-    let d = [desired[3], desired[4], desired[5], desired[6]];
-    let up = rotation::rotate(&rotation::conj(&d), [0.0, 0.0, 1.0]);
-    rotation::cube_rotations()
-        .into_iter()
-        .filter(|g| {
-            let moved = rotation::rotate(g, up);
-            let dot: f64 = moved.iter().zip(up).map(|(a, b)| a * b).sum();
-            dot.abs() > 0.99
-        })
-        .collect()
 }
