@@ -949,10 +949,12 @@ impl Acting<'_> {
 
     /// The deterministic action toward `desired` for one observation, judged by `test`: the
     /// start gesture's for its first steps where the card has one and the cube started towards
-    /// the fingertips; then shown the goal led on where the card says so, from the object's
-    /// goal now, and by the member handed over to once the episode has stalled, where it says
-    /// so, or throughout by the member of the start route that took the episode, or else of
-    /// the gesture, where either names one; `achieved` reads the object's goal only for these.
+    /// the fingertips; then, where the card says so, with the observation and the object's goal
+    /// now read in the object's frame nearest `desired` ([`Goal::nearest_frame`]), shown the
+    /// goal led on from the object's goal now, and by the member handed over to once the
+    /// episode has stalled, or throughout by the member of the start route that took the
+    /// episode, or else of the gesture, where either names one; `achieved` reads the object's
+    /// goal only for these.
     /// A residual on the card, if any, adds its correction to that action
     /// ([`crate::residual`]).
     pub fn act_toward(
