@@ -252,22 +252,28 @@ impl Goal for RotGoal {
     /// it: about that axis in axis mode (4), and the flips too in pair mode (8). The paper's
     /// test reads the whole orientation, so it has none but the identity.
     fn nearest_frame(&self, achieved: &[f64], desired: &[f64]) -> Option<(Quat, Vec<f64>)> {
+        let either_way_up = match self.mode {
+            RotMode::Paper => return None,
+            RotMode::Axis => false,
+            RotMode::Pair => true,
+        };
         let (a, d) = (quat(achieved), quat(desired));
         let up = rotation::rotate(&rotation::conj(&d), [0.0, 0.0, 1.0]);
-        let keeps_up = |g: &Quat| {
+        let keeps_up = |g: &&Quat| {
             let along: f64 = (rotation::rotate(g, up).iter().zip(up))
                 .map(|(x, y)| x * y)
                 .sum();
-            match self.mode {
-                RotMode::Paper => false,
-                RotMode::Axis => along > 0.99,
-                RotMode::Pair => along.abs() > 0.99,
+            if either_way_up {
+                along.abs() > 0.99
+            } else {
+                along > 0.99
             }
         };
         let off = |g: &Quat| rotation::angle_between(&rotation::mul(&a, g), &d);
         // The identity comes first, so a tie keeps the frame the object is read in.
-        let g = (rotation::cube_rotations().into_iter())
+        let g = (rotation::cube_group().iter())
             .filter(keeps_up)
+            .copied()
             .min_by(|g, h| off(g).total_cmp(&off(h)))?;
         let mut reached = achieved.to_vec();
         reached[3..POSE_GOAL].copy_from_slice(&relabelled(&a, &g));

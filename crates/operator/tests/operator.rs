@@ -585,9 +585,21 @@ fn gradual_opening_ramps_the_hand_from_where_it_was() {
     }
 }
 
+/// The folder of the shipped policies.
+fn models() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
+}
+
+/// A folder of this test process's own under the system's temporary folder, made.
+fn scratch_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// The shipped policies, loaded for the cube scene, and the cube's resting point.
 fn shipped_stages() -> (dexcube_operator::eval::LoadedStages, [f64; 3]) {
-    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let models = models();
     let files = dexcube_operator::eval::PolicyFiles {
         rot: models.join("rot"),
         layer: models.join("layer"),
@@ -874,7 +886,7 @@ fn a_recorded_stage_2_start_replays_the_operators_run_exactly() {
 #[test]
 fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
     let (mut stages, resting) = shipped_stages();
-    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/rot");
+    let models = models().join("rot");
     let card_rate = |stages: &dexcube_operator::eval::LoadedStages| {
         dexcube_operator::stages::trained_control_rate(&stages.stage1.policy, &models)
     };
@@ -929,9 +941,8 @@ fn a_policy_runs_at_the_control_rate_it_was_trained_at() {
 fn a_stage_1_policy_in_the_nearest_frame_acts_as_its_policy_on_the_cube_read_there() {
     let (stages, _) = shipped_stages();
     let device = burn::prelude::Device::flex();
-    let dir = std::env::temp_dir().join(format!("dexcube-nearest-frame-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let dir = scratch_dir("dexcube-nearest-frame");
+    let models = models();
     let out = dir.join("rot-nearest");
     Policy::in_nearest_frame(&models.join("rot"), &out, "test").unwrap();
     let nearest = Policy::load(&out, &device).unwrap();
@@ -1028,9 +1039,8 @@ fn refusal(result: Result<(), dexcube_rl::checkpoint::CheckpointError>) -> Strin
 fn a_start_gesture_comes_first_only_towards_the_fingertips() {
     let (stages, resting) = shipped_stages();
     let device = burn::prelude::Device::flex();
-    let dir = std::env::temp_dir().join(format!("dexcube-start-gesture-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/layer");
+    let dir = scratch_dir("dexcube-start-gesture");
+    let shipped = models().join("layer");
     let gesture = knuckles(resting[1]);
     let out = dir.join("layer-gesture");
     Policy::with_start_gesture(&shipped, gesture.clone(), &out, "test").unwrap();
@@ -1083,9 +1093,8 @@ fn a_start_gesture_comes_first_only_towards_the_fingertips() {
 fn start_routes_hand_the_thumbs_side_and_near_square_gestures_to_their_members() {
     let (stages, resting) = shipped_stages();
     let device = burn::prelude::Device::flex();
-    let dir = std::env::temp_dir().join(format!("dexcube-start-route-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let dir = scratch_dir("dexcube-start-route");
+    let models = models();
     let (shipped, wide) = (models.join("layer"), models.join("layer-w512-19"));
     let joined = dir.join("joined");
     Policy::ensemble(&[shipped.clone(), wide.clone()], &joined, "test").unwrap();
