@@ -22,7 +22,8 @@
 //! at a target action smoothed by clipped Gaussian noise, and the actor (still along the first
 //! critic) learns on every `policy_delay`-th step only.
 
-use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
+use burn::module::{Module, ModuleMapper, ModuleVisitor, Param, ParamId};
+use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer, OptimizerRecord};
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use rand::{Rng, SeedableRng};
@@ -88,6 +89,20 @@ struct TwinCritic {
     critic: Mlp,
     target: Mlp,
     optimizer: ModuleOptimizer,
+}
+
+/// The learner's state beside its networks and normalisers, as a checkpoint keeps it so that a
+/// resumed run goes on exactly as an uninterrupted one would: each optimiser's moments, the
+/// optimisation steps taken (which time TD3's delayed actor) and where the stream of TD3's
+/// smoothing noise stands.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LearnerState {
+    pub steps: usize,
+    /// The smoothing noise generator's word position (a decimal `u128`).
+    pub smoothing_position: String,
+    /// For each optimised network (actor, critic, then TD3's second critic), the ids its
+    /// parameters had, in visiting order: its optimiser's moments are keyed by them.
+    pub parameter_ids: Vec<Vec<u64>>,
 }
 
 /// What one optimisation step measured.
@@ -466,6 +481,103 @@ impl Agent {
         twin.target = params::write(twin.target.clone(), &saved[1], replace)?;
         Ok(())
     }
+
+    /// The learner's state beside its networks, with the optimisers' records in the order
+    /// of [`LearnerState::parameter_ids`] (actor, critic, then TD3's second critic).
+    pub fn learner_state(&self) -> (LearnerState, Vec<OptimizerRecord>) {
+        let mut ids = vec![parameter_ids(&self.actor), parameter_ids(&self.critic)];
+        let mut records = vec![
+            self.actor_optimizer.to_record(),
+            self.critic_optimizer.to_record(),
+        ];
+        if let Some(twin) = &self.twin {
+            ids.push(parameter_ids(&twin.critic));
+            records.push(twin.optimizer.to_record());
+        }
+        let state = LearnerState {
+            steps: self.steps,
+            smoothing_position: self.smoothing_rng.get_word_pos().to_string(),
+            parameter_ids: ids,
+        };
+        (state, records)
+    }
+
+    /// Restores what [`Agent::learner_state`] gave, onto an agent whose networks are already
+    /// loaded: the networks take the parameter ids the optimisers' moments are keyed by.
+    pub fn load_learner_state(
+        &mut self,
+        state: &LearnerState,
+        records: Vec<OptimizerRecord>,
+    ) -> Result<(), String> {
+        let expected = 2 + self.twin.is_some() as usize;
+        if state.parameter_ids.len() != expected || records.len() != expected {
+            return Err(format!(
+                "it keeps the optimisers of {} networks, this agent has {expected}",
+                state.parameter_ids.len()
+            ));
+        }
+        let position: u128 = state
+            .smoothing_position
+            .parse()
+            .map_err(|_| format!("'{}' is no stream position", state.smoothing_position))?;
+        let mut restored = state.parameter_ids.iter().zip(records);
+        let mut next = || restored.next().expect("counted");
+        let (actor_ids, actor_record) = next();
+        self.actor = with_parameter_ids(self.actor.clone(), actor_ids)?;
+        self.actor_optimizer = AdamConfig::new().init().load_record(actor_record);
+        let (critic_ids, critic_record) = next();
+        self.critic = with_parameter_ids(self.critic.clone(), critic_ids)?;
+        self.critic_optimizer = AdamConfig::new().init().load_record(critic_record);
+        if let Some(twin) = self.twin.as_mut() {
+            let (twin_ids, twin_record) = next();
+            twin.critic = with_parameter_ids(twin.critic.clone(), twin_ids)?;
+            twin.optimizer = AdamConfig::new().init().load_record(twin_record);
+        }
+        self.steps = state.steps;
+        self.smoothing_rng.set_word_pos(position);
+        self.policy = self.actor.valid();
+        Ok(())
+    }
+}
+
+/// The ids of `module`'s float parameters, in visiting order.
+fn parameter_ids<M: Module>(module: &M) -> Vec<u64> {
+    struct Ids(Vec<u64>);
+    impl ModuleVisitor for Ids {
+        fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+            self.0.push(param.id.val());
+        }
+    }
+    let mut ids = Ids(Vec::new());
+    module.visit(&mut ids);
+    ids.0
+}
+
+/// `module` with its float parameters given `ids`, in visiting order, and nothing else changed.
+fn with_parameter_ids<M: Module>(module: M, ids: &[u64]) -> Result<M, String> {
+    struct Renamer<'a> {
+        ids: &'a [u64],
+        at: usize,
+    }
+    impl ModuleMapper for Renamer<'_> {
+        fn map_float<const D: usize>(&mut self, mut param: Param<Tensor<D>>) -> Param<Tensor<D>> {
+            if let Some(&id) = self.ids.get(self.at) {
+                param.id = ParamId::from(id);
+            }
+            self.at += 1;
+            param
+        }
+    }
+    let mut renamer = Renamer { ids, at: 0 };
+    let module = module.map(&mut renamer);
+    if renamer.at != ids.len() {
+        return Err(format!(
+            "it keeps moments for {} parameters, the network has {}",
+            ids.len(),
+            renamer.at
+        ));
+    }
+    Ok(module)
 }
 
 /// The layer a parameter named `layers.{i}.…` belongs to.

@@ -31,7 +31,10 @@ pub struct HerBuffer {
     capacity: usize,
     episodes: VecDeque<Episode>,
     transitions: usize,
+    /// The longest episode ever stored, which the uniform draw over transitions rejects by.
     longest: usize,
+    /// Episodes stored over the buffer's life, those that have left included.
+    stored: usize,
     future_probability: f64,
     goal: Arc<dyn Goal>,
 }
@@ -50,6 +53,7 @@ impl HerBuffer {
             episodes: VecDeque::new(),
             transitions: 0,
             longest: 0,
+            stored: 0,
             future_probability,
             goal,
         }
@@ -65,11 +69,58 @@ impl HerBuffer {
         }
         self.transitions += episode.len;
         self.longest = self.longest.max(episode.len);
+        self.stored += 1;
         self.episodes.push_back(episode);
         while self.transitions > self.capacity {
             let old = self.episodes.pop_front().expect("transitions > 0");
             self.transitions -= old.len;
         }
+    }
+
+    /// Where the buffer stands, for a checkpoint: episodes stored over its life, how many of
+    /// the latest it holds, and its longest episode.
+    pub fn position(&self) -> ReplayPosition {
+        ReplayPosition {
+            stored: self.stored,
+            held: self.episodes.len(),
+            longest: self.longest,
+        }
+    }
+
+    /// Refills an empty buffer with `episodes`, the ones stored from number `first` on of a
+    /// buffer that stood at `position`: it then holds what that buffer held and draws as it
+    /// drew. Fails, saying why, if they do not reach back to its oldest episode.
+    pub fn restore(
+        &mut self,
+        first: usize,
+        episodes: Vec<Episode>,
+        position: ReplayPosition,
+    ) -> Result<(), String> {
+        if self.stored != 0 {
+            return Err("the buffer to refill already holds episodes".into());
+        }
+        let oldest = position.stored - position.held.min(position.stored);
+        if first > oldest {
+            return Err(format!(
+                "its episodes begin at number {first}, after the oldest it held, {oldest}"
+            ));
+        }
+        for episode in episodes {
+            self.store(episode);
+        }
+        if first + self.stored != position.stored || self.episodes.len() != position.held {
+            return Err(format!(
+                "its episodes from number {first} on come to {} stored and {} held, the buffer \
+                 stood at {} and {}",
+                first + self.stored,
+                self.episodes.len(),
+                position.stored,
+                position.held
+            ));
+        }
+        self.stored = position.stored;
+        self.longest = position.longest;
+        Ok(())
     }
 
     /// A transition drawn uniformly over all stored transitions, relabelled as HER does:
@@ -159,6 +210,120 @@ impl HerBuffer {
             })
             .collect()
     }
+}
+
+/// Where a buffer stands: what it must be restored to, beside its episodes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct ReplayPosition {
+    /// Episodes stored over its life, those that have left included.
+    pub stored: usize,
+    /// How many of the latest it holds.
+    pub held: usize,
+    /// Its longest episode ever stored.
+    pub longest: usize,
+}
+
+/// The first bytes of a file of episodes.
+const EPISODES_MAGIC: &[u8; 8] = b"DXEPIS01";
+
+/// Episodes of environments of `dims` as bytes, exactly: a header, their count, then each
+/// episode's length, whether it ended in an absorbing failure, and its rows (little-endian
+/// `f64` observations and goals, `f32` actions).
+pub fn episodes_to_bytes(dims: Dims, episodes: &[Episode]) -> Vec<u8> {
+    let mut out = EPISODES_MAGIC.to_vec();
+    for size in [dims.observation, dims.goal, dims.action, episodes.len()] {
+        out.extend((size as u64).to_le_bytes());
+    }
+    for e in episodes {
+        out.extend((e.len as u64).to_le_bytes());
+        out.push(e.terminated as u8);
+        for values in [&e.observation, &e.achieved_goal, &e.desired_goal] {
+            values.iter().for_each(|v| out.extend(v.to_le_bytes()));
+        }
+        e.action.iter().for_each(|v| out.extend(v.to_le_bytes()));
+    }
+    out
+}
+
+/// Reads a byte string front to back, saying where it ends too soon.
+struct Bytes<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Bytes<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        let part = self
+            .bytes
+            .get(self.at..self.at + n)
+            .ok_or_else(|| format!("it ends after {} bytes, cut short", self.bytes.len()))?;
+        self.at += n;
+        Ok(part)
+    }
+
+    fn word(&mut self) -> Result<usize, String> {
+        let b = self.take(8)?;
+        Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")) as usize)
+    }
+
+    fn floats(&mut self, n: usize) -> Result<Vec<f64>, String> {
+        Ok(self
+            .take(n * 8)?
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+            .collect())
+    }
+}
+
+/// The episodes [`episodes_to_bytes`] wrote for environments of `dims`; says what is wrong
+/// with bytes that are not such a file, are cut short, or were written for other sizes.
+pub fn episodes_from_bytes(dims: Dims, bytes: &[u8]) -> Result<Vec<Episode>, String> {
+    let mut input = Bytes { bytes, at: 0 };
+    if input.take(EPISODES_MAGIC.len())? != EPISODES_MAGIC {
+        return Err("it is not a file of episodes".into());
+    }
+    let sizes = [input.word()?, input.word()?, input.word()?];
+    if sizes != [dims.observation, dims.goal, dims.action] {
+        return Err(format!(
+            "its episodes have observation, goal and action sizes {sizes:?}, this run's are \
+             [{}, {}, {}]",
+            dims.observation, dims.goal, dims.action
+        ));
+    }
+    let count = input.word()?;
+    let mut episodes = Vec::with_capacity(count.min(1 << 16));
+    for _ in 0..count {
+        let len = input.word()?;
+        if len > 1 << 24 {
+            return Err(format!(
+                "it holds an episode of {len} steps, more than any run makes"
+            ));
+        }
+        let terminated = input.take(1)?[0] != 0;
+        let observation = input.floats((len + 1) * dims.observation)?;
+        let achieved_goal = input.floats((len + 1) * dims.goal)?;
+        let desired_goal = input.floats(len * dims.goal)?;
+        let action = input
+            .take(len * dims.action * 4)?
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
+            .collect();
+        episodes.push(Episode {
+            len,
+            observation,
+            achieved_goal,
+            desired_goal,
+            action,
+            terminated,
+        });
+    }
+    if input.at != bytes.len() {
+        return Err(format!(
+            "{} bytes follow its last episode",
+            bytes.len() - input.at
+        ));
+    }
+    Ok(episodes)
 }
 
 #[cfg(test)]

@@ -3,12 +3,17 @@
 //! replay buffer, runs `batches_per_cycle` optimisation steps and updates the targets; each
 //! epoch ends with deterministic test episodes. After every epoch it writes, atomically:
 //!
-//! - `checkpoint/`: all four networks (six with TD3's twin critics) and `state.json` (config, normalisers, progress),
-//!   from which `resume` continues. Adam's moments and the replay buffer start empty on
-//!   resume; the networks, normalisers, metrics and episode count carry over, and so does how
-//!   the run began (its warm start and critic-only epochs, which only its first call names).
-//!   The same checkpoint can also warm-start a new run (`init_from`) on a changed goal or success
-//!   test: networks and normalisers carry over, everything else starts afresh.
+//! - `checkpoint/`: all four networks (six with TD3's twin critics), each optimiser's moments
+//!   (`optimizer-*.bpk`) and `state.json` (config, normalisers, progress, the learner's step
+//!   count and noise stream, and the replay buffer's position), from which `resume`
+//!   continues exactly as an uninterrupted run would, with how the run began (its warm start
+//!   and critic-only epochs, which only its first call names). It is written whole into
+//!   `checkpoint.tmp/` and then swapped in, so a run killed at any moment leaves the last
+//!   complete one. The same checkpoint can also warm-start a new run (`init_from`) on a
+//!   changed goal or success test: networks and normalisers carry over, everything else
+//!   starts afresh.
+//! - `replay/epoch-NNNN.bin`: each epoch's episodes, exactly, as long as the replay buffer
+//!   still holds any of them; a resume refills the buffer from them.
 //! - `best.safetensors` + `best.json`: the policy with the highest test success so far.
 //! - `policy.safetensors` + `policy.json`: the latest policy.
 //! - `snapshots/epoch-NNNN.safetensors` + `.json`: the policy every `snapshot_every` epochs.
@@ -29,13 +34,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::agent::{Agent, Dims, Learners, SavedAnchor, StepStats};
+use crate::agent::{Agent, Dims, LearnerState, Learners, SavedAnchor, StepStats};
 use crate::checkpoint::{self, CheckpointError};
 use crate::config::DdpgHerConfig;
 use crate::normalizer::Normalizer;
 use crate::plot::{Series, line_plot};
 use crate::policy::Policy;
-use crate::replay::HerBuffer;
+use crate::replay::{Episode, HerBuffer, ReplayPosition, episodes_from_bytes, episodes_to_bytes};
 use crate::rollout::rollout;
 
 pub struct TrainOptions {
@@ -169,6 +174,53 @@ struct TrainState {
     /// weights are `checkpoint/anchor.safetensors`.
     #[serde(default)]
     anchor_normalizers: Option<[Normalizer; 2]>,
+    /// The learner's step count, noise stream and the ids its optimisers' moments
+    /// (`optimizer-*.bpk`) are keyed by; older checkpoints kept none.
+    #[serde(default)]
+    learner: Option<LearnerState>,
+    /// The replay buffer's position and the epochs' episode files that refill it; older
+    /// checkpoints kept none.
+    #[serde(default)]
+    replay: Option<ReplayLog>,
+}
+
+/// The replay buffer as a checkpoint finds it again: where it stood, and the files of the
+/// epochs whose episodes it still held (`replay/epoch-NNNN.bin`), oldest first.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+struct ReplayLog {
+    position: ReplayPosition,
+    segments: Vec<Segment>,
+}
+
+/// One epoch's episodes on disk: the number (counted over the buffer's life) of the first of
+/// them the buffer stored, and how many it stored.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+struct Segment {
+    epoch: usize,
+    first: usize,
+    stored: usize,
+}
+
+impl Segment {
+    fn path(dir: &Path, epoch: usize) -> PathBuf {
+        dir.join("replay").join(format!("epoch-{epoch:04}.bin"))
+    }
+}
+
+impl ReplayLog {
+    /// The log after an epoch that added `segment`: the segments whose episodes the buffer
+    /// at `position` still holds.
+    fn after(&self, segment: Segment, position: ReplayPosition) -> ReplayLog {
+        let oldest = position.stored - position.held;
+        let segments = self
+            .segments
+            .iter()
+            .copied()
+            .chain(std::iter::once(segment))
+            .filter(|s| s.first + s.stored > oldest)
+            .collect();
+        ReplayLog { position, segments }
+    }
 }
 
 /// What a run's first call set that its resumes keep, since only that call is given them: the
@@ -231,6 +283,18 @@ const TWIN_FILES: [&str; 2] = ["critic2", "target_critic2"];
 
 /// The anchor's weights in a checkpoint, for a run fine-tuned with one.
 const ANCHOR_FILE: &str = "anchor.safetensors";
+
+/// The optimisers' moments in a checkpoint, in the order of [`LearnerState::parameter_ids`].
+const OPTIMIZER_FILES: [&str; 3] = [
+    "optimizer-actor.bpk",
+    "optimizer-critic.bpk",
+    "optimizer-critic2.bpk",
+];
+
+/// Where a checkpoint is written before it is swapped in, and where the one it replaces waits
+/// meanwhile.
+const CHECKPOINT_NEW: &str = "checkpoint.tmp";
+const CHECKPOINT_OLD: &str = "checkpoint.old";
 
 /// The critics in the checkpoint of a training run (the first, and TD3's second where the run
 /// had one), with what they read their inputs through: what a guide takes from a run.
@@ -296,10 +360,11 @@ pub fn train<E: GoalEnv>(
     let mut agent = Agent::new(dims, config.clone(), &Device::flex(), options.seed);
     let mut buffer = HerBuffer::new(dims, config.buffer_size, config.future_probability(), goal);
     let resumed = match (options.resume, &options.out_dir) {
-        (true, Some(dir)) => resume(&mut agent, dir, options)?,
+        (true, Some(dir)) => resume(&mut agent, &mut buffer, dir, options)?,
         _ => None,
     };
-    let (mut metrics, start) = resumed.unwrap_or_else(|| (Vec::new(), RunStart::of(options)));
+    let (mut metrics, start, mut replay) =
+        resumed.unwrap_or_else(|| (Vec::new(), RunStart::of(options), ReplayLog::default()));
     if metrics.is_empty() {
         let warm = options.init_from.is_some() || options.init_actor.is_some();
         if options.zero_output && warm {
@@ -349,6 +414,8 @@ pub fn train<E: GoalEnv>(
         } else {
             Learners::ActorAndCritic
         };
+        let first_stored = buffer.position().stored;
+        let mut epoch_episodes: Vec<Episode> = Vec::new();
         for cycle in 0..cycles {
             let t = Instant::now();
             let (episodes, s) = rollout(
@@ -368,6 +435,9 @@ pub fn train<E: GoalEnv>(
                 for (o, g) in buffer.normalizer_rows(&episode, episode.len, &mut rng) {
                     agent.observation_norm.update(o);
                     agent.goal_norm.update(g);
+                }
+                if options.out_dir.is_some() {
+                    epoch_episodes.push(episode.clone());
                 }
                 buffer.store(episode);
             }
@@ -432,7 +502,22 @@ pub fn train<E: GoalEnv>(
         best = best.max(row.test_success);
         metrics.push(row);
         if let Some(dir) = &options.out_dir {
-            save_epoch(&agent, dir, options, &start, &metrics, improved)?;
+            let position = buffer.position();
+            let segment = Segment {
+                epoch,
+                first: first_stored,
+                stored: position.stored - first_stored,
+            };
+            let bytes = episodes_to_bytes(dims, &epoch_episodes);
+            checkpoint::write_atomically(&Segment::path(dir, epoch), &bytes)?;
+            replay = replay.after(segment, position);
+            let run = SavedRun {
+                agent: &agent,
+                start: &start,
+                metrics: &metrics,
+                replay: &replay,
+            };
+            save_epoch(run, dir, options, improved)?;
         }
     }
     bar.finish();
@@ -476,15 +561,37 @@ fn card_metadata(
     })
 }
 
+/// What an epoch's checkpoint saves of the run.
+struct SavedRun<'a> {
+    agent: &'a Agent,
+    start: &'a RunStart,
+    metrics: &'a [EpochMetrics],
+    replay: &'a ReplayLog,
+}
+
 fn save_epoch(
-    agent: &Agent,
+    run: SavedRun,
     dir: &Path,
     options: &TrainOptions,
-    start: &RunStart,
-    metrics: &[EpochMetrics],
     improved: bool,
 ) -> Result<(), TrainError> {
-    let checkpoint_dir = dir.join("checkpoint");
+    let SavedRun {
+        agent,
+        start,
+        metrics,
+        replay,
+    } = run;
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |e: std::io::Error| CheckpointError::Io {
+            path,
+            message: e.to_string(),
+        }
+    };
+    let checkpoint_dir = dir.join(CHECKPOINT_NEW);
+    if checkpoint_dir.exists() {
+        std::fs::remove_dir_all(&checkpoint_dir).map_err(io(&checkpoint_dir))?;
+    }
     let twin = agent
         .twin_networks()
         .into_iter()
@@ -499,6 +606,14 @@ fn save_epoch(
     if let Some(anchor) = &anchor {
         checkpoint::save_tensors(&checkpoint_dir.join(ANCHOR_FILE), &anchor.actor)?;
     }
+    let (learner, records) = agent.learner_state();
+    for (record, name) in records.into_iter().zip(OPTIMIZER_FILES) {
+        let path = checkpoint_dir.join(name);
+        record.save(&path).map_err(|e| CheckpointError::Io {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+    }
     let state = TrainState {
         label: options.label.clone(),
         seed: options.seed,
@@ -510,9 +625,24 @@ fn save_epoch(
         start: Some(start.clone()),
         init_from: None,
         anchor_normalizers: anchor.map(|anchor| [anchor.observation_norm, anchor.goal_norm]),
+        learner: Some(learner),
+        replay: Some(replay.clone()),
     };
-    // The state goes last: a checkpoint is complete once state.json names its epoch.
+    // The state goes last: a checkpoint is complete once state.json names its epoch. Then it
+    // takes the place of the last one, which waits aside until it has.
     checkpoint::save_json(&checkpoint_dir.join("state.json"), &state)?;
+    let (current, old) = (dir.join("checkpoint"), dir.join(CHECKPOINT_OLD));
+    if old.exists() {
+        std::fs::remove_dir_all(&old).map_err(io(&old))?;
+    }
+    if current.exists() {
+        std::fs::rename(&current, &old).map_err(io(&current))?;
+    }
+    std::fs::rename(&checkpoint_dir, &current).map_err(io(&current))?;
+    if old.exists() {
+        std::fs::remove_dir_all(&old).map_err(io(&old))?;
+    }
+    forget_old_episodes(dir, replay)?;
     let mut prefixes = vec![dir.join("policy")];
     if improved {
         prefixes.push(dir.join("best"));
@@ -528,6 +658,57 @@ fn save_epoch(
     checkpoint::write_atomically(&dir.join("metrics.csv"), (csv.join("\n") + "\n").as_bytes())?;
     if let Err(e) = plot_learning_curve(dir, &options.label, options.seed, metrics) {
         eprintln!("warning: no learning-curve plot: {e}");
+    }
+    Ok(())
+}
+
+/// Removes the epochs' episode files that the checkpoint no longer lists: those the buffer has
+/// let go, and any an interrupted epoch wrote beyond it.
+fn forget_old_episodes(dir: &Path, replay: &ReplayLog) -> Result<(), TrainError> {
+    let folder = dir.join("replay");
+    let Ok(entries) = std::fs::read_dir(&folder) else {
+        return Ok(());
+    };
+    let kept: std::collections::HashSet<PathBuf> = replay
+        .segments
+        .iter()
+        .map(|s| Segment::path(dir, s.epoch))
+        .collect();
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if !kept.contains(&path) {
+            std::fs::remove_file(&path).map_err(|e| CheckpointError::Io {
+                path: path.clone(),
+                message: e.to_string(),
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// Puts back the last complete checkpoint of the run in `dir` where a run killed while
+/// swapping one in left it: the new one is complete once its state is written, and the old
+/// one is whole until the new one has taken its place.
+fn recover_checkpoint(dir: &Path) -> Result<(), TrainError> {
+    let current = dir.join("checkpoint");
+    if current.join("state.json").exists() {
+        return Ok(());
+    }
+    for aside in [CHECKPOINT_NEW, CHECKPOINT_OLD] {
+        let aside = dir.join(aside);
+        if aside.join("state.json").exists() {
+            if current.exists() {
+                std::fs::remove_dir_all(&current).map_err(|e| CheckpointError::Io {
+                    path: current.clone(),
+                    message: e.to_string(),
+                })?;
+            }
+            std::fs::rename(&aside, &current).map_err(|e| CheckpointError::Io {
+                path: aside.clone(),
+                message: e.to_string(),
+            })?;
+            return Ok(());
+        }
     }
     Ok(())
 }
@@ -600,11 +781,16 @@ impl RunCurve {
     }
 }
 
+/// The run in `dir` loaded to go on: its networks, normalisers and (where its checkpoint kept
+/// them) its optimisers' moments, step count, noise stream and replay buffer; then its
+/// metrics, how it began and its replay log. `None` if it has no checkpoint yet.
 fn resume(
     agent: &mut Agent,
+    buffer: &mut HerBuffer,
     dir: &Path,
     options: &TrainOptions,
-) -> Result<Option<(Vec<EpochMetrics>, RunStart)>, TrainError> {
+) -> Result<Option<(Vec<EpochMetrics>, RunStart, ReplayLog)>, TrainError> {
+    recover_checkpoint(dir)?;
     let checkpoint_dir = dir.join("checkpoint");
     if !checkpoint_dir.join("state.json").exists() {
         return Ok(None);
@@ -648,11 +834,67 @@ fn resume(
             .load_anchor(saved)
             .map_err(|e| mismatch(&path, e.to_string()))?;
     }
+    let replay = match (&resumed.learner, &resumed.replay) {
+        (Some(learner), Some(replay)) => {
+            let records = (0..learner.parameter_ids.len())
+                .map(|k| {
+                    let path = checkpoint_dir.join(OPTIMIZER_FILES[k]);
+                    burn::optim::OptimizerRecord::load(&path).map_err(|e| {
+                        TrainError::Checkpoint(CheckpointError::Corrupt {
+                            path,
+                            message: e.to_string(),
+                        })
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            agent
+                .load_learner_state(learner, records)
+                .map_err(|message| mismatch(&checkpoint_dir, message))?;
+            refill(buffer, dir, agent.dims, replay)?;
+            replay.clone()
+        }
+        _ => {
+            eprintln!(
+                "warning: {} keeps no optimiser moments or replay buffer (an older checkpoint): \
+                 the run goes on with fresh moments and an empty buffer",
+                checkpoint_dir.display()
+            );
+            ReplayLog::default()
+        }
+    };
     let start = resumed.start.unwrap_or_else(|| RunStart {
         init_from: resumed.init_from,
         ..RunStart::of(options)
     });
-    Ok(Some((resumed.metrics, start)))
+    Ok(Some((resumed.metrics, start, replay)))
+}
+
+/// Refills the empty `buffer` from the episode files `replay` lists.
+fn refill(
+    buffer: &mut HerBuffer,
+    dir: &Path,
+    dims: Dims,
+    replay: &ReplayLog,
+) -> Result<(), TrainError> {
+    let mut episodes = Vec::new();
+    for segment in &replay.segments {
+        let path = Segment::path(dir, segment.epoch);
+        let bytes = std::fs::read(&path).map_err(|e| CheckpointError::Io {
+            path: path.clone(),
+            message: format!("{e}; the checkpoint needs it to refill the replay buffer"),
+        })?;
+        let read =
+            episodes_from_bytes(dims, &bytes).map_err(|message| CheckpointError::Corrupt {
+                path: path.clone(),
+                message,
+            })?;
+        episodes.extend(read);
+    }
+    let first = replay.segments.first().map_or(0, |s| s.first);
+    buffer
+        .restore(first, episodes, replay.position)
+        .map_err(|message| mismatch(&dir.join("replay"), message))?;
+    Ok(())
 }
 
 /// Takes the networks and normalisers of the run in `dir`, for a new run. The run may have had

@@ -122,6 +122,115 @@ fn a_run_writes_its_files_and_resumes_where_it_stopped() {
     assert!(err.to_string().contains("is a run of point mass"), "{err}");
 }
 
+/// An epoch's record without its clock times, which no two runs share.
+fn untimed(m: &dexcube_rl::EpochMetrics) -> dexcube_rl::EpochMetrics {
+    dexcube_rl::EpochMetrics {
+        env_steps_per_s: 0.0,
+        rollout_s: 0.0,
+        learning_s: 0.0,
+        other_s: 0.0,
+        wall_s: 0.0,
+        ..m.clone()
+    }
+}
+
+#[test]
+fn a_resumed_run_goes_on_exactly_as_an_uninterrupted_one() {
+    // TD3, for its second critic, its delayed actor and its noise stream, and a buffer of two
+    // epochs' transitions, so that older epochs' episodes leave it and their files go.
+    let td3 = DdpgHerConfig {
+        buffer_size: 600,
+        ..config().with_td3()
+    };
+    let whole_dir = fresh_dir("dexcube-rl-exact-whole");
+    let whole = train(
+        PointMassEnv::default,
+        td3.clone(),
+        &options(&whole_dir, 5, false),
+    )
+    .unwrap();
+    let split_dir = fresh_dir("dexcube-rl-exact-split");
+    train(
+        PointMassEnv::default,
+        td3.clone(),
+        &options(&split_dir, 2, false),
+    )
+    .unwrap();
+    // A kill while the next checkpoint was being written leaves part of it aside, and the
+    // interrupted epoch's episodes: neither may count.
+    let aside = split_dir.join("checkpoint.tmp");
+    std::fs::create_dir_all(&aside).unwrap();
+    std::fs::write(aside.join("actor.safetensors"), b"half").unwrap();
+    std::fs::write(split_dir.join("replay/epoch-0002.bin"), b"half").unwrap();
+    let split = train(
+        PointMassEnv::default,
+        td3.clone(),
+        &options(&split_dir, 5, true),
+    )
+    .unwrap();
+    let (a, b): (Vec<_>, Vec<_>) = (
+        whole.metrics.iter().map(untimed).collect(),
+        split.metrics.iter().map(untimed).collect(),
+    );
+    assert_eq!(a, b, "every epoch's figures alike");
+    for (x, y) in whole
+        .agent
+        .networks()
+        .into_iter()
+        .zip(split.agent.networks())
+    {
+        assert_eq!(by_name(x), by_name(y), "the same weights, bit for bit");
+    }
+    assert_eq!(
+        whole.agent.twin_networks().map(|t| t.map(by_name)),
+        split.agent.twin_networks().map(|t| t.map(by_name))
+    );
+    // Only the epochs whose episodes the buffer still holds keep their files.
+    let files = |dir: &std::path::Path| {
+        let mut names: Vec<String> = std::fs::read_dir(dir.join("replay"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    assert_eq!(files(&whole_dir), ["epoch-0003.bin", "epoch-0004.bin"]);
+    assert_eq!(files(&split_dir), files(&whole_dir));
+    assert!(!aside.exists(), "the part written aside is gone");
+    // Without its episodes the buffer cannot be refilled, and the resume says which file.
+    std::fs::remove_file(split_dir.join("replay/epoch-0004.bin")).unwrap();
+    let err = train(
+        PointMassEnv::default,
+        td3.clone(),
+        &options(&split_dir, 6, true),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(err.contains("epoch-0004.bin"), "{err}");
+    std::fs::write(split_dir.join("replay/epoch-0004.bin"), b"DXEPIS01").unwrap();
+    let err = train(PointMassEnv::default, td3, &options(&split_dir, 6, true))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("epoch-0004.bin") && err.contains("cut short"),
+        "{err}"
+    );
+}
+
+/// A run killed while its new checkpoint was swapped in (the old one moved aside, the new one
+/// complete) resumes from the new one.
+#[test]
+fn a_checkpoint_caught_between_swaps_is_found_again() {
+    let dir = fresh_dir("dexcube-rl-swap");
+    train(PointMassEnv::default, config(), &options(&dir, 2, false)).unwrap();
+    std::fs::rename(dir.join("checkpoint"), dir.join("checkpoint.tmp")).unwrap();
+    let resumed = train(PointMassEnv::default, config(), &options(&dir, 3, true)).unwrap();
+    assert_eq!(resumed.metrics.len(), 3, "it went on from epoch 2");
+    assert!(dir.join("checkpoint/state.json").is_file());
+}
+
 #[test]
 fn a_resumed_run_keeps_how_it_began() {
     // The first call names the warm start and the critic-only epochs; a resume names neither.
