@@ -156,6 +156,26 @@ pub trait GoalEnv: Send {
     fn step(&mut self, action: &[f64]) -> Transition;
 }
 
+/// Any goal environment behind a box is one too, so that a run whose phases build different
+/// environments can step them alike.
+impl GoalEnv for Box<dyn GoalEnv> {
+    fn spaces(&self) -> Spaces {
+        (**self).spaces()
+    }
+
+    fn goal(&self) -> Arc<dyn Goal> {
+        (**self).goal()
+    }
+
+    fn reset(&mut self, seed: Option<u64>) -> (Observation, Info) {
+        (**self).reset(seed)
+    }
+
+    fn step(&mut self, action: &[f64]) -> Transition {
+        (**self).step(action)
+    }
+}
+
 /// An environment backed by a MuJoCo simulation, for rendering and inspection.
 pub trait SimulatedEnv: GoalEnv {
     fn sim(&self) -> &dexcube_sim::Sim;

@@ -8,7 +8,9 @@
 //! - [`networks`] and [`agent`]: the actor, the critic, their targets and the update;
 //! - [`replay`]: the HER buffer, relabelling goals at sampling time;
 //! - [`rollout`]: episodes from a `VecEnv`;
-//! - [`train`]: the epoch / cycle / batch schedule with checkpoints, curves and resume;
+//! - [`train`]: the epoch / cycle / batch schedule with checkpoints, curves and exact resume;
+//! - [`recipe`]: a skill learned from random weights in one run of phases, each ended by a
+//!   rule read from its own test success;
 //! - [`start_file`]: recorded Stage 1 starts on disk, to train and evaluate from;
 //! - [`seeds`]: learning curves across seeds, mean ± one standard deviation;
 //! - [`policy`]: a trained actor as shipped, with its normalisers;
@@ -39,6 +41,7 @@ pub mod params;
 pub mod plot;
 pub mod point_mass;
 pub mod policy;
+pub mod recipe;
 pub mod replay;
 pub mod residual;
 pub mod rollout;

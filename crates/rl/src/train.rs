@@ -25,6 +25,7 @@
 //! is reset with a seed derived from (seed, k, i), and exploration noise from (seed, epoch).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use burn::prelude::*;
@@ -75,6 +76,11 @@ pub struct TrainOptions {
     /// zero: a residual's start, which acts as its base ([`crate::residual`]). A fresh run's
     /// only: a warm start brings an actor of its own.
     pub zero_output: bool,
+    /// Stop before `epochs` once this rule is met (a recipe's phase that has done its work).
+    pub until: Option<Until>,
+    /// Called with every epoch's metrics so far once its checkpoint is written (a recipe
+    /// keeps its whole curve up to date).
+    pub after_epoch: Option<Arc<EpochHook>>,
     /// Show a progress bar with ETA on stderr.
     pub progress: bool,
     /// What is being trained, for plots and policy cards.
@@ -99,10 +105,37 @@ impl TrainOptions {
             snapshot_every: 0,
             critic_only_epochs: 0,
             zero_output: false,
+            until: None,
+            after_epoch: None,
             progress: false,
             label: label.into(),
             metadata: serde_json::json!({}),
         }
+    }
+}
+
+/// What [`TrainOptions::after_epoch`] calls.
+pub type EpochHook = dyn Fn(&[EpochMetrics]) -> Result<(), TrainError> + Send + Sync;
+
+/// When a run has done its work before its last epoch: once the mean test success of its
+/// last `window` epochs reaches `success`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Until {
+    pub success: f64,
+    pub window: usize,
+}
+
+impl Until {
+    /// Whether a run with these epochs has met the rule.
+    pub fn met(&self, metrics: &[EpochMetrics]) -> bool {
+        let window = self.window.max(1);
+        metrics.len() >= window
+            && metrics[metrics.len() - window..]
+                .iter()
+                .map(|m| m.test_success)
+                .sum::<f64>()
+                / window as f64
+                >= self.success
     }
 }
 
@@ -249,6 +282,7 @@ pub enum TrainError {
     Resume(String),
     WarmStart(String),
     Plot(String),
+    Recipe(String),
 }
 
 impl std::fmt::Display for TrainError {
@@ -258,6 +292,7 @@ impl std::fmt::Display for TrainError {
             TrainError::Resume(message) => write!(f, "cannot resume: {message}"),
             TrainError::WarmStart(message) => write!(f, "cannot warm-start: {message}"),
             TrainError::Plot(message) => write!(f, "cannot draw the learning curve: {message}"),
+            TrainError::Recipe(message) => write!(f, "cannot run the recipe: {message}"),
         }
     }
 }
@@ -402,7 +437,11 @@ pub fn train<E: GoalEnv>(
         .iter()
         .map(|m| m.test_success)
         .fold(f64::NEG_INFINITY, f64::max);
+    let done = |metrics: &[EpochMetrics]| options.until.is_some_and(|rule| rule.met(metrics));
     for epoch in metrics.len()..options.epochs {
+        if done(&metrics) {
+            break;
+        }
         let epoch_start = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
         rng.set_stream(epoch as u64);
@@ -518,6 +557,9 @@ pub fn train<E: GoalEnv>(
                 replay: &replay,
             };
             save_epoch(run, dir, options, improved)?;
+        }
+        if let Some(hook) = &options.after_epoch {
+            hook(&metrics)?;
         }
     }
     bar.finish();
