@@ -328,7 +328,7 @@ impl PolicyArgs {
             if !card.is_file() {
                 bail!(
                     "no policy at {}: the shipped ones are under models/ (git checkout models), or train one \
-                     with `dexcube train rot --mode axis` / `dexcube train layer --move \"U'\"` and pass its best policy",
+                     with `dexcube train rot` / `dexcube train layer` and pass its policy (DIR/policy)",
                     card.display()
                 );
             }
@@ -390,12 +390,12 @@ pub struct EvalArgs {
     /// Also record where every Stage 1 run began (the physics state once the hand has
     /// opened, and the pose asked for) into this file, each marked failed if the run dropped
     /// the cube or ended without the pose the check after Stage 1 accepts, for
-    /// `train rot --starts` and `eval-stage rot --starts`. Needs a fresh --out.
+    /// a recipe phase's `starts` and `eval-stage rot --starts`. Needs a fresh --out.
     #[arg(long, value_name = "FILE")]
     record_starts: Option<PathBuf>,
     /// Also record where every Stage 2 run began (the physics state once the hand has
     /// opened) into this file, each marked failed if the run did not leave the layer turned
-    /// with the cube square, for `train layer --starts` and `eval-stage layer --starts`.
+    /// with the cube square, for a recipe phase's `starts` and `eval-stage layer --starts`.
     /// Needs a fresh --out.
     #[arg(long, value_name = "FILE")]
     record_layer_starts: Option<PathBuf>,

@@ -10,6 +10,7 @@ mod distil;
 mod env;
 mod eval;
 mod net;
+mod recipe;
 mod render;
 mod solve;
 mod stage;

@@ -1,30 +1,25 @@
-//! `dexcube train`: DDPG + HER on CubeRotEnv or LayerOpEnv, with a progress bar, metrics CSV,
-//! learning curves, checkpoints every epoch, the best policy kept, and resume.
+//! `dexcube train`: a skill trained by a recipe (see [`crate::recipe`]), with a progress bar,
+//! one metrics CSV and curves over the whole recipe, checkpoints every epoch and exact resume;
+//! and the commands that draw runs' curves and make policies of trained ones.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::Arc;
 
 use anyhow::bail;
 use clap::Args;
-use dexcube_env::layer::{LayerGoals, LayerMove};
-use dexcube_env::{
-    ControlRate, CubeRotEnv, EpisodeSettings, GoalEnv, GoalLead, LayerOpEnv, StartMix, StartPick,
-};
+use dexcube_env::GoalLead;
+use dexcube_rl::Policy;
 use dexcube_rl::checkpoint::CheckpointError;
 use dexcube_rl::handover::{FarHandover, Handover};
-use dexcube_rl::residual::{ResidualEnv, ResidualSetting, check_scale};
+use dexcube_rl::recipe::{RecipeRun, run_recipe};
 use dexcube_rl::start_gesture::StartGesture;
 use dexcube_rl::start_route::{RoutedEpisodes, StartRoute};
-use dexcube_rl::{DdpgHerConfig, Policy, TrainOptions, train};
-use dexcube_sim::Scene;
 
-use crate::env::{
-    EnvChoice, EnvKind, PAPER_ANGLE_THRESHOLD, angle_flag, physics_spread, starts_for,
-};
+use crate::env::{EnvKind, angle_flag};
+use crate::recipe::{PhaseEnv, RecipeFile};
 
-/// How training collects experience, shared by `train` and `bench rl`. Eight environments
-/// on two threads balance physics against the 40 batches of a cycle on a 2-core machine.
+/// How `bench rl` collects experience. Eight environments on two threads balance physics
+/// against the 40 batches of a cycle on a 2-core machine.
 #[derive(Args)]
 pub struct Workers {
     /// Environments stepped together; each gives one episode per cycle.
@@ -38,123 +33,123 @@ pub struct Workers {
     pub seed: u64,
 }
 
-/// Trains an atomic action with DDPG + HER (the HER baselines' hyperparameters).
+/// Trains a skill from random weights by a recipe: every phase it needs, in one run that moves
+/// from phase to phase by rules read from its own test success (`dexcube train rot
+/// --print-recipe` shows them). Writes DIR/policy (the skill's policy), DIR/metrics.csv and
+/// curves against env steps and hours, and each phase's run under DIR/phases; a run stopped at
+/// any moment goes on with `--resume DIR`.
 #[derive(Args)]
 pub struct TrainArgs {
-    #[command(flatten)]
-    choice: EnvChoice,
-    /// Epochs of 50 cycles (each: one episode per environment, then 40 batches).
-    #[arg(long, default_value_t = 50)]
-    epochs: usize,
-    #[command(flatten)]
-    workers: Workers,
-    /// Output folder (default: runs/<env>-<mode or move>-seed<seed>).
-    #[arg(long, conflicts_with = "resume")]
+    /// The skill: rot (Stage 1, CubeRotEnv) or layer (Stage 2, LayerOpEnv).
+    #[arg(value_enum, required_unless_present = "resume")]
+    skill: Option<EnvKind>,
+    /// The recipe: dexcube (ours), paper (DDPG + HER at the paper's settings, in one phase),
+    /// or the path of a JSON file of one.
+    #[arg(long, default_value = "dexcube")]
+    recipe: String,
+    /// Print the recipe as JSON and exit, a start for a recipe of your own.
+    #[arg(long)]
+    print_recipe: bool,
+    /// Seed of everything random: weights, episodes, exploration.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Output folder (default: runs/<skill>-<recipe>-seed<seed>).
+    #[arg(long)]
     out: Option<PathBuf>,
-    /// Continue the run in this folder from its last checkpoint.
-    #[arg(long, value_name = "DIR")]
+    /// Go on with the run in this folder where it stopped; its recipe, skill and seed are
+    /// the ones it began with.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["skill", "out", "print_recipe"])]
     resume: Option<PathBuf>,
-    /// Warm start from the networks and normalisers of the run in this folder (for example
-    /// to fine-tune on another success test or goal range); a new run in --out.
-    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
-    init: Option<PathBuf>,
-    /// Warm start the actor and its normalisers from this policy (PREFIX.safetensors and
-    /// PREFIX.json, e.g. models/rot, which may be an earlier epoch than a run's last
-    /// checkpoint). The critic comes from the --init run, or without one starts afresh: then
-    /// give it --critic-only-epochs to learn the policy's values first.
-    #[arg(long, value_name = "PREFIX", conflicts_with = "resume")]
-    init_actor: Option<PathBuf>,
-    /// LayerOpEnv only: train on the evaluation goal, exactly a quarter turn, rather than
-    /// goals uniform over it (HER still relabels with the angles reached on the way).
-    #[arg(long)]
-    quarter_goals: bool,
-    /// Train only the critic for this run's first N epochs, the actor held as loaded: for a
-    /// warm start (--init) onto another object or success test (0: DDPG as published). A
-    /// resumed run keeps the number it began with.
-    #[arg(long, default_value_t = 0, value_name = "N", conflicts_with = "resume")]
-    critic_only_epochs: usize,
-    /// Keep the policy of every this many epochs under DIR/snapshots (0: none).
-    #[arg(long, default_value_t = 5)]
-    snapshot_every: usize,
-    /// Units in each of the networks' three hidden layers (the paper's 256). A warm start
-    /// (--init, --init-actor) from narrower networks embeds them, so the wider networks begin
-    /// acting as they did. A resume must say it again.
-    #[arg(long, default_value_t = 256, value_name = "UNITS", value_parser = clap::value_parser!(u16).range(1..))]
-    width: u16,
-    /// Optimisation batches per cycle (HER baselines: 40).
-    #[arg(long, default_value_t = 40)]
-    batches: usize,
-    /// Gaussian exploration noise as a share of the action range (HER baselines: 0.2).
-    #[arg(long, value_name = "SHARE")]
-    noise_eps: Option<f64>,
-    /// Probability of a uniformly random action while exploring (HER baselines: 0.3).
-    /// Fine-tuning a policy that already succeeds may want less of both.
-    #[arg(long, value_name = "P")]
-    random_eps: Option<f64>,
-    /// Adam learning rate of the actor (HER baselines: 0.001).
-    #[arg(long, value_name = "RATE")]
-    actor_lr: Option<f64>,
-    /// Fine-tuning: weight of a penalty on the actor's squared distance from the actor it
-    /// starts from (--init or --init-actor), beside the action penalty (DDPG: 0).
-    #[arg(long, default_value_t = 0.0, value_name = "WEIGHT")]
-    anchor: f64,
-    /// What dropping the cube is worth in the critic's targets, as a multiple of the floor
-    /// -1/(1-γ) that missing for ever is worth (DDPG: 1). A resume must say it again.
-    #[arg(long, default_value_t = 1.0, value_name = "MULTIPLE")]
-    drop_cost: f64,
-    /// Train without Hindsight Experience Replay (plain DDPG), for ablations.
-    #[arg(long)]
-    no_her: bool,
-    /// Train with TD3's critics instead of DDPG's (Fujimoto et al. 2018: twin critics, target
-    /// policy smoothing, the actor updated every second step), HER and the rest unchanged. A
-    /// resume must say it again.
-    #[arg(long)]
-    td3: bool,
-    /// On the physical cube: begin a share of episodes (--start-share) from the starts
-    /// recorded in this file, where the operator hands the cube over, rather than from a fresh
-    /// placement: Stage 1's (`dexcube eval --record-starts`) for rot, Stage 2's (`dexcube eval
-    /// --record-layer-starts`) for layer U'. A resume must name the same.
-    #[arg(long, value_name = "FILE")]
-    starts: Option<PathBuf>,
-    /// With --starts, the probability that an episode begins from one of them.
-    #[arg(long, default_value_t = 0.5, value_name = "P", requires = "starts")]
-    start_share: f64,
-    /// With --starts, how many times as often a start the recorded policy failed from (Stage
-    /// 1: dropped the cube; Stage 2: did not leave the layer turned with the cube square) is
-    /// drawn as one it succeeded from (1: all alike).
-    #[arg(
-        long,
-        alias = "dropped-weight",
-        default_value_t = 1.0,
-        value_name = "W",
-        requires = "starts"
-    )]
-    failed_weight: f64,
-    /// Vary the physics of each training episode by this spread S (domain randomisation):
-    /// every geom's friction, the object's mass and every joint's damping are each scaled by
-    /// a factor drawn log-uniform between 1/(1+S) and 1+S from the episode's seed; the test
-    /// episodes of each epoch are varied alike (0: the scene's own physics, as the paper). A
-    /// resume must say it again.
-    #[arg(long, default_value_t = 0.0, value_name = "S", value_parser = physics_spread)]
-    physics_spread: f64,
-    /// Train a residual on top of this policy (residual policy learning: any card, e.g.
-    /// models/rot-lead-handover, acting as it is deployed) rather than a policy of its own:
-    /// the actor observes the observation followed by the base's action, its action times
-    /// --residual-scale is added to the base's, and it starts at zero, so the run first acts
-    /// as the base. `dexcube residual` ships the base and a snapshot as one policy. The
-    /// environment (view, success test) must be the one the base was trained on. A resume
-    /// must say it again.
-    #[arg(long, value_name = "PREFIX", conflicts_with_all = ["init", "init_actor"])]
-    residual_of: Option<PathBuf>,
-    /// With --residual-of, the share of the action range the residual may move the base's
-    /// action by.
-    #[arg(
-        long,
-        default_value_t = 0.1,
-        value_name = "S",
-        requires = "residual_of"
-    )]
-    residual_scale: f64,
+    /// Threads stepping the environments.
+    #[arg(long, default_value_t = 2)]
+    threads: usize,
+}
+
+/// The file in a recipe's run folder that says what it runs.
+const RECIPE_FILE: &str = "recipe.json";
+
+pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
+    if args.threads == 0 {
+        bail!("--threads must be at least 1");
+    }
+    let (dir, file) = match (&args.resume, args.skill) {
+        (Some(dir), _) => {
+            let path = dir.join(RECIPE_FILE);
+            if !path.is_file() {
+                bail!(
+                    "{} holds no recipe's run (no {RECIPE_FILE}): pass the folder `dexcube train --out` wrote",
+                    dir.display()
+                );
+            }
+            let text = std::fs::read_to_string(&path)?;
+            let file: RecipeFile = serde_json::from_str(&text).map_err(|e| {
+                anyhow::anyhow!(
+                    "{} is not a recipe's run file ({e}); it may be damaged: restore it or train again",
+                    path.display()
+                )
+            })?;
+            (dir.clone(), file)
+        }
+        (None, Some(skill)) => {
+            let recipe = crate::recipe::named(&args.recipe, skill)?;
+            if args.print_recipe {
+                println!("{}", serde_json::to_string_pretty(&recipe)?);
+                return Ok(ExitCode::SUCCESS);
+            }
+            recipe.check().map_err(anyhow::Error::msg)?;
+            let dir = args.out.clone().unwrap_or_else(|| {
+                let name = Path::new(&args.recipe)
+                    .file_stem()
+                    .map_or("recipe".into(), |s| s.to_string_lossy().into_owned());
+                PathBuf::from(format!("runs/{}-{name}-seed{}", skill.name(), args.seed))
+            });
+            if dir.join(RECIPE_FILE).exists() {
+                bail!(
+                    "{} holds a run already: go on with `dexcube train --resume {}`, or choose \
+                     another --out",
+                    dir.display(),
+                    dir.display()
+                );
+            }
+            let file = RecipeFile {
+                skill: skill.name().to_string(),
+                seed: args.seed,
+                recipe,
+            };
+            dexcube_rl::checkpoint::save_json(&dir.join(RECIPE_FILE), &file)?;
+            (dir, file)
+        }
+        (None, None) => bail!("name the skill to train (rot or layer), or --resume DIR"),
+    };
+    let skill = file.skill()?;
+    eprintln!(
+        "training {} by the recipe '{}' ({} phases) into {} (seed {})",
+        skill.stage(),
+        file.recipe.name,
+        file.recipe.phases.len(),
+        dir.display(),
+        file.seed
+    );
+    let run = RecipeRun {
+        dir: dir.clone(),
+        seed: file.seed,
+        threads: args.threads,
+        progress: true,
+    };
+    let outcome = run_recipe(&file.recipe, &run, |env: &PhaseEnv| {
+        env.envs(skill).map_err(|e| format!("{e:#}"))
+    })?;
+    let last = outcome.metrics.last();
+    eprintln!(
+        "done: {} epochs, {} env steps, {:.2} h; the policy is {}, the curves {} and {}",
+        outcome.metrics.len(),
+        last.map_or(0, |e| e.env_steps),
+        last.map_or(0.0, |e| e.wall_s / 3600.0),
+        outcome.policy.display(),
+        dir.join("success.png").display(),
+        dir.join("success-hours.png").display()
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Redraws a training run's learning curve (RUN/success.png) from its checkpoint, for a run
@@ -582,374 +577,6 @@ pub fn start_route(args: StartRouteArgs) -> anyhow::Result<ExitCode> {
         "{} routing by its start, {route}, into {}",
         args.policy.display(),
         args.out.display()
-    );
-    Ok(ExitCode::SUCCESS)
-}
-
-/// Refuses to resume a run with other recorded starts, at another control rate, under other
-/// varied physics or to another angle threshold than it began with (its checkpoint's card
-/// names them), since the card would then say it trained on starts, at a rate, on physics
-/// or to a test it did not.
-fn same_as_begun(run: &std::path::Path, args: &TrainArgs) -> anyhow::Result<()> {
-    // A missing or unreadable checkpoint is the trainer's to report.
-    let Ok(begun) = dexcube_rl::train::RunCurve::read(run) else {
-        return Ok(());
-    };
-    let flags = |starts: Option<String>, share: Option<f64>, weight: f64| match (starts, share) {
-        (Some(starts), Some(share)) => {
-            format!("--starts {starts} --start-share {share} --failed-weight {weight}")
-        }
-        _ => "no --starts".to_string(),
-    };
-    let hidden = &begun.config.hidden;
-    if hidden.iter().any(|&units| units != usize::from(args.width)) {
-        bail!(
-            "{} began with hidden layers of {hidden:?} units; resume it with the same --width, \
-             not {}",
-            run.display(),
-            args.width
-        );
-    }
-    let environment = &begun.environment;
-    let begun = flags(
-        environment["starts"].as_str().map(str::to_string),
-        environment["start_share"].as_f64(),
-        // Runs from before the weight drew every start alike; sessions 17 and 18 named it
-        // after Stage 1's failures, drops.
-        environment["failed_weight"]
-            .as_f64()
-            .or(environment["dropped_weight"].as_f64())
-            .unwrap_or(1.0),
-    );
-    let now = flags(
-        args.starts.as_ref().map(|p| p.display().to_string()),
-        Some(args.start_share),
-        args.failed_weight,
-    );
-    if begun != now {
-        bail!(
-            "{} began with {begun}; resume it with the same, not {now}",
-            run.display()
-        );
-    }
-    // Runs from before the rate could be chosen acted at the paper's.
-    let begun_rate = environment["control_substeps"]
-        .as_u64()
-        .map_or(dexcube_sim::SUBSTEPS, |n| n as usize);
-    if begun_rate != args.choice.control_rate.substeps() {
-        bail!(
-            "{} began acting every {begun_rate} substeps; resume it with --control-substeps \
-             {begun_rate}, not {}",
-            run.display(),
-            args.choice.control_rate
-        );
-    }
-    // Runs from before residuals could be trained trained policies of their own.
-    let begun_residual: Option<ResidualSetting> =
-        serde_json::from_value(environment["residual"].clone()).unwrap_or(None);
-    let now_residual = residual_setting(args);
-    if begun_residual != now_residual {
-        let said = |setting: Option<ResidualSetting>| match setting {
-            Some(r) => format!(
-                "--residual-of {} --residual-scale {}",
-                r.of.display(),
-                r.scale
-            ),
-            None => "no --residual-of".to_string(),
-        };
-        bail!(
-            "{} began with {}; resume it with the same, not {}",
-            run.display(),
-            said(begun_residual),
-            said(now_residual)
-        );
-    }
-    // Runs from before physics could be varied ran on the scene's own, and runs from before
-    // the threshold could be chosen trained to the paper's.
-    for (key, flag, given, before) in [
-        (
-            "physics_spread",
-            "--physics-spread",
-            args.physics_spread,
-            0.0,
-        ),
-        (
-            "angle_threshold",
-            "--angle-threshold",
-            args.choice.angle_threshold,
-            PAPER_ANGLE_THRESHOLD,
-        ),
-    ] {
-        let begun = environment[key].as_f64().unwrap_or(before);
-        if begun != given {
-            bail!(
-                "{} began with {flag} {begun}; resume it with the same, not {given}",
-                run.display()
-            );
-        }
-    }
-    Ok(())
-}
-
-/// The residual a run trains; none for a policy of its own.
-fn residual_setting(args: &TrainArgs) -> Option<ResidualSetting> {
-    args.residual_of.as_ref().map(|of| ResidualSetting {
-        of: of.clone(),
-        scale: args.residual_scale,
-    })
-}
-
-/// Trains on the environments `make` makes, or with `residual` (the base and the scale) on
-/// top of the base acting in them.
-fn train_on<E: GoalEnv + 'static>(
-    make: impl Fn() -> E,
-    residual: Option<(Arc<Policy>, f64)>,
-    config: DdpgHerConfig,
-    options: &TrainOptions,
-) -> anyhow::Result<dexcube_rl::train::Trained> {
-    let Some((base, scale)) = residual else {
-        return Ok(train(make, config, options)?);
-    };
-    // Checked once here, so that every environment after it is made alike.
-    if let Err(message) = ResidualEnv::new(make(), base.clone(), scale) {
-        bail!("cannot train a residual: {message}");
-    }
-    let wrapped = || {
-        ResidualEnv::new(make(), base.clone(), scale)
-            .unwrap_or_else(|message| unreachable!("checked above: {message}"))
-    };
-    Ok(train(wrapped, config, options)?)
-}
-
-pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
-    let Workers {
-        envs,
-        threads,
-        seed,
-    } = args.workers;
-    if envs == 0 || threads == 0 || args.epochs == 0 {
-        bail!("--envs, --threads and --epochs must be at least 1");
-    }
-    if args.quarter_goals && matches!(args.choice.env, EnvKind::Rot) {
-        bail!("--quarter-goals is for LayerOpEnv (train layer)");
-    }
-    let object = args.choice.object()?;
-    let square = args.choice.square()?;
-    let view = args.choice.view()?;
-    if args.starts.is_some()
-        && matches!(args.choice.env, EnvKind::Layer)
-        && args.choice.layer_move != LayerMove::UPrime
-    {
-        bail!(
-            "--starts for layer are the operator's Stage 2 starts: train them with --move \"U'\""
-        );
-    }
-    if !(0.0..=1.0).contains(&args.start_share) {
-        bail!(
-            "--start-share must be between 0 and 1, not {}",
-            args.start_share
-        );
-    }
-    if !(args.failed_weight.is_finite() && args.failed_weight > 0.0) {
-        bail!(
-            "--failed-weight must be a positive number, not {}",
-            args.failed_weight
-        );
-    }
-    let rate = args.choice.control_rate;
-    let suffix = args
-        .choice
-        .named_object()?
-        .map(|object| format!("-{}", object.name()))
-        .unwrap_or_default();
-    let variant = match args.choice.env {
-        EnvKind::Rot => args.choice.mode.name().to_string() + &suffix,
-        EnvKind::Layer => {
-            args.choice.layer_move.name().replace('\'', "p")
-                + if args.quarter_goals { "-quarter" } else { "" }
-                + &suffix
-        }
-    } + if square { "-square" } else { "" }
-        + if args.choice.intact()? { "-intact" } else { "" }
-        + if args.choice.turn_ends { "-ends" } else { "" }
-        + if view.misalignment { "-seen" } else { "" }
-        + if view.grip { "-grip" } else { "" }
-        + &if rate == ControlRate::PAPER {
-            String::new()
-        } else {
-            format!("-sub{rate}")
-        }
-        + if args.residual_of.is_some() {
-            "-residual"
-        } else {
-            ""
-        };
-    let name = args.choice.env.name();
-    let (out, resume) = match (&args.out, &args.resume) {
-        (_, Some(dir)) => (dir.clone(), true),
-        (Some(dir), None) => (dir.clone(), false),
-        (None, None) => (
-            PathBuf::from(format!("runs/{name}-{variant}-seed{}", seed)),
-            false,
-        ),
-    };
-    if resume {
-        same_as_begun(&out, &args)?;
-    }
-    let published = DdpgHerConfig::default();
-    let mut config = DdpgHerConfig {
-        // Baselines' 1 - 1/T, T the episode's control steps: the same discount per simulated
-        // second at any control rate.
-        gamma: 1.0 - 1.0 / rate.episode_steps() as f64,
-        batches_per_cycle: args.batches,
-        her: !args.no_her,
-        noise_eps: args.noise_eps.unwrap_or(published.noise_eps),
-        random_eps: args.random_eps.unwrap_or(published.random_eps),
-        actor_lr: args.actor_lr.unwrap_or(published.actor_lr),
-        anchor: args.anchor,
-        drop_cost: args.drop_cost,
-        hidden: vec![usize::from(args.width); published.hidden.len()],
-        ..published
-    };
-    if args.td3 {
-        config = config.with_td3();
-    }
-    if !(config.actor_lr > 0.0 && config.actor_lr.is_finite()) {
-        bail!(
-            "--actor-lr must be a positive number, not {}",
-            config.actor_lr
-        );
-    }
-    if !(config.anchor >= 0.0 && config.anchor.is_finite()) {
-        bail!("--anchor must be 0 or more, not {}", config.anchor);
-    }
-    if !(config.drop_cost >= 1.0 && config.drop_cost.is_finite()) {
-        bail!(
-            "--drop-cost must be 1 (the floor) or more, not {}",
-            config.drop_cost
-        );
-    }
-    if config.anchor > 0.0 && args.init.is_none() && args.init_actor.is_none() && !resume {
-        bail!("--anchor holds the actor near the one it starts from: pass --init or --init-actor");
-    }
-    for (name, value) in [
-        ("--noise-eps", config.noise_eps),
-        ("--random-eps", config.random_eps),
-    ] {
-        if !(0.0..=1.0).contains(&value) {
-            bail!("{name} must be between 0 and 1, not {value}");
-        }
-    }
-    let options = TrainOptions {
-        epochs: args.epochs,
-        envs,
-        threads,
-        seed,
-        out_dir: Some(out.clone()),
-        resume,
-        init_from: args.init.clone(),
-        init_actor: args.init_actor.clone(),
-        snapshot_every: args.snapshot_every,
-        critic_only_epochs: args.critic_only_epochs,
-        zero_output: args.residual_of.is_some(),
-        progress: true,
-        label: args.choice.name()?,
-        metadata: serde_json::json!({
-            "env": name,
-            "variant": variant,
-            "goals": if args.quarter_goals { "quarter turn" } else { "uniform" },
-            "success": format!(
-                "{}{}",
-                match args.choice.env {
-                    EnvKind::Rot => "pose",
-                    EnvKind::Layer => "angle",
-                },
-                args.choice.success_suffix("cube ")?
-            ),
-            "observation": view.name().map_or("paper".to_string(), |name| format!("with the {name}")),
-            "object": object.name(),
-            "mode": matches!(args.choice.env, EnvKind::Rot).then(|| args.choice.mode.name()),
-            "critic_only_epochs": args.critic_only_epochs,
-            "init_actor": args.init_actor.as_ref().map(|p| p.display().to_string()),
-            "starts": args.starts.as_ref().map(|p| p.display().to_string()),
-            "start_share": args.starts.as_ref().map(|_| args.start_share),
-            "failed_weight": args.starts.as_ref().map(|_| args.failed_weight),
-            "control_substeps": rate.substeps(),
-            "physics_spread": args.physics_spread,
-            "angle_threshold": args.choice.angle_threshold,
-            "residual": residual_setting(&args),
-        }),
-    };
-    eprintln!(
-        "training {} into {} (seed {})",
-        options.label,
-        out.display(),
-        seed
-    );
-    let scene = Scene::load(object.scene())?;
-    let starts = match &args.starts {
-        Some(path) => Some(StartMix {
-            starts: starts_for(path, &scene, args.choice.env)?.0,
-            pick: StartPick::Share {
-                share: args.start_share,
-                failed_weight: args.failed_weight,
-            },
-        }),
-        None => None,
-    };
-    let settings = EpisodeSettings {
-        rate,
-        physics_spread: args.physics_spread,
-        ..EpisodeSettings::PAPER
-    };
-    if let Err(message) = check_scale(args.residual_scale) {
-        bail!("--residual-scale: {message}");
-    }
-    let residual = match &args.residual_of {
-        Some(base) => Some((
-            Arc::new(Policy::load(base, &burn::prelude::Device::flex())?),
-            args.residual_scale,
-        )),
-        None => None,
-    };
-    let trained = match args.choice.env {
-        EnvKind::Rot => {
-            let goal = args.choice.rot_goal()?;
-            let make = || {
-                CubeRotEnv::with_scene(scene.clone(), goal)
-                    .with_view(view)
-                    .with_starts(starts.clone())
-                    .with_settings(settings)
-            };
-            train_on(make, residual, config, &options)?
-        }
-        EnvKind::Layer => {
-            let (layer_move, goal) = (args.choice.layer_move, args.choice.layer_goal()?);
-            let goals = if args.quarter_goals {
-                LayerGoals::Evaluation
-            } else {
-                LayerGoals::Training
-            };
-            let make = || {
-                LayerOpEnv::with_scene(scene.clone(), layer_move, goals)
-                    .with_goal(goal)
-                    .with_view(view)
-                    .with_starts(starts.clone())
-                    .with_settings(settings)
-            };
-            train_on(make, residual, config, &options)?
-        }
-    };
-    let best = trained
-        .metrics
-        .iter()
-        .map(|m| m.test_success)
-        .fold(0.0, f64::max);
-    eprintln!(
-        "done: {} epochs, best test success {best:.2}; best policy in {}, curves in {}",
-        trained.metrics.len(),
-        out.join("best.safetensors").display(),
-        out.join("success.png").display()
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -588,137 +588,212 @@ fn each_environment_takes_only_objects_it_can_hold() {
     }
 }
 
-/// Settings a training run cannot use are refused before it starts, each with its reason.
+/// A recipe of `phases` (JSON objects of a phase's `name`, `env` and more) on small networks
+/// and short epochs, one environment, for runs of seconds.
+fn tiny_recipe(phases: &[serde_json::Value]) -> serde_json::Value {
+    let phases: Vec<serde_json::Value> = phases
+        .iter()
+        .map(|phase| {
+            let mut full = serde_json::json!({
+                "max_epochs": 1, "until": null, "noise_eps": null, "random_eps": null,
+                "anchor": 0.0, "critic_only_epochs": 0,
+            });
+            for (key, value) in phase.as_object().unwrap() {
+                full[key] = value.clone();
+            }
+            full
+        })
+        .collect();
+    serde_json::json!({
+        "name": "tiny",
+        "config": {
+            "hidden": [32, 32], "cycles_per_epoch": 2, "batches_per_cycle": 2,
+            "test_episodes": 1, "twin_critics": true, "target_noise": 0.2, "policy_delay": 2,
+        },
+        "envs": 1,
+        "phases": phases,
+    })
+}
+
+/// Writes `recipe` as `dir/name.json` and gives its path.
+fn recipe_file(dir: &std::path::Path, name: &str, recipe: &serde_json::Value) -> String {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join(format!("{name}.json"));
+    std::fs::write(&path, serde_json::to_string_pretty(recipe).unwrap()).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// Recipes a training run cannot use are refused before it starts, each with its reason, the
+/// phase named; so are a folder that holds a run already and a folder that holds none.
 #[test]
-fn train_refuses_settings_it_cannot_run() {
-    for (args, says) in [
+fn train_refuses_recipes_it_cannot_run() {
+    let dir = std::env::temp_dir().join("dexcube-cli-bad-recipes");
+    let _ = std::fs::remove_dir_all(&dir);
+    let phase = |env: serde_json::Value| serde_json::json!({"name": "p", "env": env});
+    for (skill, env, says) in [
         (
-            &["rot", "--quarter-goals"][..],
-            "--quarter-goals is for LayerOpEnv",
+            "rot",
+            serde_json::json!({"quarter_goals": true}),
+            "move and quarter_goals are LayerOpEnv's",
         ),
-        (&["rot", "--square"], "--square is for the physical cube"),
         (
-            &["layer", "--object", "block", "--see-misalignment"],
+            "rot",
+            serde_json::json!({"square": true}),
+            "--square is for the physical cube",
+        ),
+        (
+            "layer",
+            serde_json::json!({"object": "block", "see_misalignment": true}),
             "--see-misalignment is for the physical cube",
         ),
         (
-            &["rot", "--see-misalignment"],
-            "--see-misalignment is for the physical cube",
-        ),
-        (
-            &["rot", "--see-grip"],
+            "rot",
+            serde_json::json!({"see_grip": true}),
             "--see-grip is for the physical cube",
         ),
         (
-            &["layer", "--random-eps", "1.5"],
-            "--random-eps must be between 0 and 1",
+            "rot",
+            serde_json::json!({"intact": true}),
+            "--intact is for the physical cube",
         ),
         (
-            &["layer", "--noise-eps=-0.1"],
-            "--noise-eps must be between 0 and 1",
-        ),
-        (&["rot", "--actor-lr", "0"], "--actor-lr must be a positive"),
-        (&["rot", "--anchor=-1"], "--anchor must be 0 or more"),
-        (&["rot", "--anchor", "10"], "pass --init or --init-actor"),
-        (
-            &["rot", "--drop-cost", "0.5"],
-            "--drop-cost must be 1 (the floor) or more",
-        ),
-        (
-            &["layer", "--move", "U", "--starts", "s"],
-            "train them with --move \"U'\"",
-        ),
-        (&["rot", "--start-share", "0.2"], "--starts <FILE>"),
-        (
-            &["rot", "--starts", "s", "--start-share", "2"],
-            "--start-share must be between 0 and 1",
-        ),
-        (
-            &["rot", "--starts", "s", "--dropped-weight", "0"],
-            "--failed-weight must be a positive number",
-        ),
-        (&["rot", "--failed-weight", "5"], "--starts <FILE>"),
-        (&["rot", "--intact"], "--intact is for the physical cube"),
-        (&["rot", "--object", "cube", "--turn-ends"], "--intact"),
-        (
-            &["rot", "--control-substeps", "3"],
-            "3 substeps per control step: use a number that divides",
-        ),
-        (
-            &["rot", "--physics-spread=-0.1"],
-            "--physics-spread must be 0 or more",
-        ),
-        (
-            &["rot", "--angle-threshold", "0"],
-            "--angle-threshold must be an angle in radians above 0",
-        ),
-        (
-            &["layer", "--angle-threshold", "4"],
-            "--angle-threshold must be an angle in radians above 0",
-        ),
-        (
-            &["layer", "--object", "cube", "--intact"],
+            "layer",
+            serde_json::json!({"intact": true}),
             "--intact is for CubeRotEnv",
         ),
         (
-            &["rot", "--object", "cube", "--starts", "/no/such/starts"],
+            "layer",
+            serde_json::json!({"mode": "pair"}),
+            "mode is CubeRotEnv's success test",
+        ),
+        (
+            "rot",
+            serde_json::json!({"object": "block"}),
+            "CubeRotEnv holds the rigid or the physical cube",
+        ),
+        (
+            "rot",
+            serde_json::json!({"object": "glass"}),
+            "unknown object 'glass'",
+        ),
+        (
+            "rot",
+            serde_json::json!({"control_substeps": 3}),
+            "3 substeps per control step: use a number that divides",
+        ),
+        (
+            "rot",
+            serde_json::json!({"physics_spread": -0.1}),
+            "--physics-spread must be 0 or more",
+        ),
+        (
+            "layer",
+            serde_json::json!({"angle_threshold": 4.0}),
+            "angle_threshold must be an angle in radians above 0",
+        ),
+        (
+            "rot",
+            serde_json::json!({"start_share": 0.2}),
+            "name them in starts",
+        ),
+        (
+            "rot",
+            serde_json::json!({"object": "cube", "starts": "s", "start_share": 2.0}),
+            "start_share must be between 0 and 1",
+        ),
+        (
+            "rot",
+            serde_json::json!({"object": "cube", "starts": "s", "failed_weight": 0.0}),
+            "failed_weight must be a positive number",
+        ),
+        (
+            "layer",
+            serde_json::json!({"move": "U", "starts": "s"}),
+            "train them with the move U'",
+        ),
+        (
+            "rot",
+            serde_json::json!({"object": "cube", "starts": "/no/such/starts"}),
             "record starts with `dexcube eval",
         ),
         (
-            &[
-                "rot",
-                "--object",
-                "cube",
-                "--init-actor",
-                concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/layer"),
-            ],
-            "cannot warm-start: the policy",
-        ),
-        // The shipped Stage 1 sees the cube's misalignment; this environment does not.
-        (
-            &[
-                "rot",
-                "--mode",
-                "pair",
-                "--object",
-                "cube",
-                "--square",
-                "--residual-of",
-                concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/rot"),
-            ],
-            "cannot train a residual: the base policy takes",
-        ),
-        (
-            &[
-                "rot",
-                "--residual-of",
-                "models/rot",
-                "--residual-scale",
-                "0",
-            ],
-            "--residual-scale: a residual's scale must be above 0 and at most 1",
-        ),
-        (
-            &["rot", "--residual-scale", "0.2"],
-            "--residual-of <PREFIX>",
-        ),
-        (
-            &[
-                "rot",
-                "--residual-of",
-                "models/rot",
-                "--init-actor",
-                "models/rot",
-            ],
-            "cannot be used with",
+            "rot",
+            serde_json::json!({"colour": "red"}),
+            "unknown field `colour`",
         ),
     ] {
+        let recipe = recipe_file(&dir, "bad", &tiny_recipe(&[phase(env)]));
+        let out = dir.join("run");
         let o = dexcube(
-            &[&["train"][..], args, &["--out", "/nonexistent/run"]].concat(),
+            &[
+                "train",
+                skill,
+                "--recipe",
+                &recipe,
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            "",
+        );
+        assert_clean_failure(&o, 2, says);
+        if !says.starts_with("unknown field") {
+            assert_clean_failure(&o, 2, "phase 'p'");
+        }
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    let mut anchored = tiny_recipe(&[phase(serde_json::json!({}))]);
+    anchored["phases"][0]["anchor"] = 10.0.into();
+    for (recipe, says) in [
+        (anchored, "starts from random weights"),
+        (serde_json::json!({"name": "x"}), "is not a recipe"),
+    ] {
+        let recipe = recipe_file(&dir, "bad", &recipe);
+        let o = dexcube(
+            &[
+                "train",
+                "rot",
+                "--recipe",
+                &recipe,
+                "--out",
+                "/nonexistent/run",
+            ],
             "",
         );
         assert_clean_failure(&o, 2, says);
     }
+    let o = dexcube(&["train", "rot", "--recipe", "nope"], "");
+    assert_clean_failure(
+        &o,
+        2,
+        "no recipe 'nope': name a shipped one (dexcube, paper)",
+    );
+    let o = dexcube(&["train", "--resume", dir.to_str().unwrap()], "");
+    assert_clean_failure(&o, 2, "holds no recipe's run");
+    let o = dexcube(&["train", "--resume", "/tmp", "--seed", "3"], "");
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "a resume takes the run's own seed"
+    );
+    let o = dexcube(&["train"], "");
+    assert_clean_failure(&o, 2, "<SKILL>");
+    // A folder that holds a run is resumed, not trained into again.
+    let recipe = recipe_file(&dir, "one", &tiny_recipe(&[phase(serde_json::json!({}))]));
+    let out = dir.join("done");
+    let train = [
+        "train",
+        "rot",
+        "--recipe",
+        &recipe,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    assert!(dexcube(&train, "").status.success());
+    assert_clean_failure(
+        &dexcube(&train, ""),
+        2,
+        "holds a run already: go on with `dexcube train --resume",
+    );
     // Shipping a residual: an actor not trained as one is refused.
     let [base, actor] = ["rot", "rot-td3-19"].map(|name| models().join(name));
     let [base, actor] = [&base, &actor].map(|path| path.to_str().unwrap());
@@ -726,28 +801,32 @@ fn train_refuses_settings_it_cannot_run() {
     assert_clean_failure(&o, 2, "it was not trained as a residual");
 }
 
-/// A policy of either stage warm-started onto a view beyond the paper's gains its inputs
-/// (Stage 2 the cube's misalignment: 63 observations, from `layer-anchor69`'s 62; Stage 1 that
-/// and the grip: 68, from the shipped 61; the policy's own kept), and `eval-stage` and the operator give it that view, told by its size;
-/// `eval-stage` on the other object (the rigid cube, the block), which the views are not
-/// for, refuses it cleanly.
+/// A policy of either stage trained onto a view beyond the paper's, from a phase that had the
+/// paper's, gains its inputs (Stage 2 the cube's misalignment: 63 observations, from 62;
+/// Stage 1 that and the grip: 68, from 61), and `eval-stage` and the operator give it that
+/// view, told by its size; `eval-stage` on the other object (the rigid cube, the block), which
+/// the views are not for, refuses it cleanly.
 #[test]
 fn a_policy_trained_seeing_more_is_evaluated_with_it() {
-    for (stage, init, view, env_args, observation, seen, other_object) in [
+    for (stage, first, seen_env, observation, seen, other_object) in [
         (
             "rot",
-            "rot-dropw20",
-            &["--see-misalignment", "--see-grip"][..],
-            &["--mode", "pair"][..],
+            serde_json::json!({"mode": "pair"}),
+            serde_json::json!({
+                "mode": "pair", "object": "cube", "square": true,
+                "see_misalignment": true, "see_grip": true,
+            }),
             68,
             "misalignment and grip",
             "rigid",
         ),
         (
             "layer",
-            "layer-anchor69",
-            &["--see-misalignment"],
-            &["--quarter-goals"],
+            serde_json::json!({"object": "block", "quarter_goals": true}),
+            serde_json::json!({
+                "object": "cube", "square": true, "quarter_goals": true,
+                "see_misalignment": true,
+            }),
             63,
             "misalignment",
             "block",
@@ -755,38 +834,36 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
     ] {
         let dir = std::env::temp_dir().join(format!("dexcube-cli-see-more-{stage}"));
         let _ = std::fs::remove_dir_all(&dir);
-        let init = models().join(init);
-        let (init, out) = (init.to_str().unwrap(), dir.to_str().unwrap());
-        let train = ["train", stage, "--object", "cube", "--square"];
+        let phases = [
+            serde_json::json!({"name": "paper-view", "env": first}),
+            serde_json::json!({"name": "seen", "env": seen_env, "critic_only_epochs": 1}),
+        ];
+        let recipe = recipe_file(&dir, "recipe", &tiny_recipe(&phases));
+        let run = dir.join("run");
+        let out = run.to_str().unwrap();
         let o = dexcube(
             &[
-                &train[..],
-                view,
-                env_args,
-                &[
-                    "--init-actor",
-                    init,
-                    "--critic-only-epochs",
-                    "1",
-                    "--epochs",
-                    "1",
-                ],
-                &["--envs", "1", "--threads", "1", "--batches", "1"],
-                &["--snapshot-every", "0", "--out", out],
-            ]
-            .concat(),
+                "train",
+                stage,
+                "--recipe",
+                &recipe,
+                "--threads",
+                "1",
+                "--out",
+                out,
+            ],
             "",
         );
         assert!(o.status.success(), "{}", stderr(&o));
         let card: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap())
+            serde_json::from_str(&std::fs::read_to_string(run.join("policy.json")).unwrap())
                 .unwrap();
         assert_eq!(card["dims"]["observation"], observation);
         assert_eq!(
             card["metadata"]["environment"]["observation"],
             format!("with the {seen}")
         );
-        let policy = dir.join("policy");
+        let policy = run.join("policy");
         let policy = policy.to_str().unwrap().to_string();
         let [rot_flag, rot, layer_flag, layer] = shipped_policy_flags();
         let (rot, layer) = match stage {
@@ -816,87 +893,104 @@ fn a_policy_trained_seeing_more_is_evaluated_with_it() {
     }
 }
 
-/// A run resumes only with the recorded starts it began with, and drawn as they were, so
-/// that its card never names starts it did not train on: session 12's run began with none,
-/// session 13's with starts all drawn alike (a card from before the weight), and session
-/// 17's with failed starts drawn 20 times as often (a card that names the weight by Stage 1's
-/// failures, `dropped_weight`); only at the control rate it began with (session 12's, from
-/// before the rate could be chosen, the paper's); and only on the physics it began with
-/// (before physics could be varied, the scene's own); and only with networks of the width it
-/// began with.
+/// The shipped recipes print as recipe files that run as they are.
 #[test]
-fn train_resumes_only_with_the_starts_rate_physics_and_width_it_began_with() {
-    let resume = |committed_run: &str, starts: &[&str]| {
-        let run = std::env::temp_dir().join(format!("dexcube-cli-resume-{committed_run}"));
-        let _ = std::fs::remove_dir_all(&run);
-        std::fs::create_dir_all(run.join("checkpoint")).unwrap();
-        let committed = format!(
-            "{}/../../results/training/{committed_run}/checkpoint/state.json",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        std::fs::copy(committed, run.join("checkpoint/state.json")).unwrap();
-        let run = run.to_str().unwrap().to_string();
-        let square = ["rot", "--mode", "pair", "--object", "cube", "--square"];
-        let args = [&["train"][..], &square, &["--resume", &run], starts].concat();
-        dexcube(&args, "")
+fn a_shipped_recipe_prints_as_a_file_that_runs() {
+    for skill in ["rot", "layer"] {
+        for name in ["dexcube", "paper"] {
+            let o = dexcube(&["train", skill, "--recipe", name, "--print-recipe"], "");
+            assert!(o.status.success(), "{}", stderr(&o));
+            let recipe: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+            assert_eq!(recipe["name"], name);
+            let phases = recipe["phases"].as_array().unwrap();
+            assert!(!phases.is_empty());
+            if name == "paper" {
+                assert_eq!(recipe["config"]["twin_critics"], false, "the paper's DDPG");
+                assert_eq!(phases.len(), 1);
+            }
+        }
+    }
+}
+
+/// A recipe killed at moments spread over its run (SIGKILL, so nothing is tidied) and resumed
+/// each time with `--resume DIR` alone writes the rows of an uninterrupted run, clock times
+/// aside, and the same policy, bit for bit.
+#[test]
+fn a_recipe_killed_at_any_moment_resumes_to_the_uninterrupted_run() {
+    let dir = std::env::temp_dir().join("dexcube-cli-kill");
+    let _ = std::fs::remove_dir_all(&dir);
+    let phases = [
+        serde_json::json!({"name": "axis-rigid", "env": {"mode": "axis"}, "max_epochs": 3}),
+        serde_json::json!({
+            "name": "pair-cube", "env": {"mode": "pair", "object": "cube", "square": true},
+            "max_epochs": 3, "anchor": 10.0, "critic_only_epochs": 1, "noise_eps": 0.1,
+        }),
+    ];
+    let recipe = recipe_file(&dir, "recipe", &tiny_recipe(&phases));
+    let train = |out: &std::path::Path| {
+        Command::new(env!("CARGO_BIN_EXE_dexcube"))
+            .args([
+                "train",
+                "rot",
+                "--recipe",
+                &recipe,
+                "--seed",
+                "5",
+                "--threads",
+                "1",
+            ])
+            .args(["--out", out.to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap()
     };
-    assert_clean_failure(
-        &resume(
-            "rot-pair-cube-square-anchor5-seed0",
-            &["--starts", "s.safetensors"],
-        ),
-        2,
-        "began with no --starts; resume it with the same, not --starts s.safetensors",
-    );
-    let recorded = "runs/starts-train-seed1.safetensors";
-    assert_clean_failure(
-        &resume(
-            "rot-pair-cube-square-starts-seed0",
-            &["--starts", recorded, "--dropped-weight", "5"],
-        ),
-        2,
-        &format!(
-            "began with --starts {recorded} --start-share 0.5 --failed-weight 1; resume it \
-             with the same, not --starts {recorded} --start-share 0.5 --failed-weight 5"
-        ),
-    );
-    assert_clean_failure(
-        &resume(
-            "rot-pair-cube-square-dropw20-seed0",
-            &["--starts", recorded, "--failed-weight", "5"],
-        ),
-        2,
-        "--start-share 0.5 --failed-weight 20; resume it",
-    );
-    assert_clean_failure(
-        &resume(
-            "rot-pair-cube-square-anchor5-seed0",
-            &["--control-substeps", "10"],
-        ),
-        2,
-        "began acting every 20 substeps; resume it with --control-substeps 20, not 10",
-    );
-    assert_clean_failure(
-        &resume(
-            "rot-pair-cube-square-anchor5-seed0",
-            &["--physics-spread", "0.3"],
-        ),
-        2,
-        "began with --physics-spread 0; resume it with the same, not 0.3",
-    );
-    assert_clean_failure(
-        &resume(
-            "rot-pair-cube-square-anchor5-seed0",
-            &["--angle-threshold", "0.05"],
-        ),
-        2,
-        "began with --angle-threshold 0.1; resume it with the same, not 0.05",
-    );
-    assert_clean_failure(
-        &resume("rot-pair-cube-square-anchor5-seed0", &["--width", "512"]),
-        2,
-        "began with hidden layers of [256, 256, 256] units; resume it with the same --width, \
-         not 512",
+    let untimed = |out: &std::path::Path| -> Vec<String> {
+        std::fs::read_to_string(out.join("metrics.csv"))
+            .unwrap()
+            .lines()
+            .map(|line| {
+                let cells: Vec<&str> = line.split(',').collect();
+                [&cells[..6], &cells[7..12]].concat().join(",")
+            })
+            .collect()
+    };
+    let whole = dir.join("whole");
+    let started = std::time::Instant::now();
+    assert!(train(&whole).wait().unwrap().success());
+    let took = started.elapsed();
+    let expected = untimed(&whole);
+    assert_eq!(expected.len(), 7, "a header and six epochs");
+    let split = dir.join("split");
+    let mut child = train(&split);
+    let mut kills = 0;
+    for share in [0.2, 0.45, 0.7] {
+        std::thread::sleep(took.mul_f64(share));
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        child.kill().unwrap();
+        child.wait().unwrap();
+        kills += 1;
+        child = Command::new(env!("CARGO_BIN_EXE_dexcube"))
+            .args([
+                "train",
+                "--resume",
+                split.to_str().unwrap(),
+                "--threads",
+                "1",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+    }
+    assert!(child.wait().unwrap().success());
+    assert!(kills >= 1, "at least one kill landed before the run ended");
+    assert_eq!(untimed(&split), expected, "after {kills} kills");
+    assert_eq!(
+        std::fs::read(split.join("policy.safetensors")).unwrap(),
+        std::fs::read(whole.join("policy.safetensors")).unwrap()
     );
 }
 

@@ -9,7 +9,7 @@
 //! ([`EpisodeSettings::action_slew`]), to ask whether gentler fingers jam less. `--keep-jams
 //! OUT` writes, for every jammed episode, the physics state at steps 10, 30 and 60 as Stage 2
 //! starts (the quarter turn asked for, counted from the angle the layer had turned, marked
-//! failed), so that a run can train from inside a jam (`dexcube train layer --starts OUT`).
+//! failed), so that a run can train from inside a jam (a recipe phase of `dexcube train layer` with `starts` OUT).
 //! `--steps N` runs each episode for N control steps instead of the paper's 100, sorts it by
 //! how it stands at step N, and counts the episodes that step 100 judged otherwise: whether
 //! more time would turn the layers Stage 2 leaves unturned.

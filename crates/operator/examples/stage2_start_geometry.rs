@@ -10,9 +10,9 @@
 //!
 //! With `--mark-side SIDE OUT` (SIDE one of x-, x+, y-, y+) it also writes the starts, joined,
 //! to OUT with every start on that side of the resting point marked as failed beside those
-//! the recorded policy failed from, so that `dexcube train --starts OUT --failed-weight W`
+//! the recorded policy failed from, so that a recipe phase with `starts` OUT and `failed_weight` W
 //! draws that side W times as often. With `--only-side SIDE OUT` it writes only the starts on
-//! that side, their marks as recorded: a run that trains there alone (`--start-share 1`), or
+//! that side, their marks as recorded: a run that trains there alone (`start_share` 1), or
 //! an evaluation of that side alone (`dexcube eval-stage layer --starts OUT`). With
 //! `--max-yaw DEG` first, the side takes in only its starts whose yaw from square is at most
 //! DEG degrees: the near-square placements on one side.

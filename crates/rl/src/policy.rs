@@ -697,7 +697,7 @@ impl Policy {
                     mismatch(
                         &weights,
                         "it was not trained as a residual (its card's metadata.environment \
-                         has no residual: train one with `dexcube train --residual-of BASE`)"
+                         has no residual; a residual is trained in a ResidualEnv)"
                             .to_string(),
                     )
                 })?;
