@@ -5,10 +5,9 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
-use dexcube_env::layer::LayerGoals;
 use dexcube_env::{
-    ControlRate, CubeRotEnv, EpisodeSettings, GoalEnv, LayerGoal, LayerMove, LayerOpEnv,
-    ObjectKind, RecordedFailure, RotGoal, RotMode, View,
+    ControlRate, EnvSettings, EnvSpec, GoalEnv, LayerMove, ObjectKind, PAPER_ANGLE_THRESHOLD,
+    RecordedFailure, RotMode, Skill,
 };
 use dexcube_sim::Scene;
 use rand::{Rng, SeedableRng};
@@ -36,6 +35,14 @@ impl EnvKind {
         match self {
             EnvKind::Rot => "rot",
             EnvKind::Layer => "layer",
+        }
+    }
+
+    /// The skill the environment learns.
+    pub fn skill(self) -> Skill {
+        match self {
+            EnvKind::Rot => Skill::Rot,
+            EnvKind::Layer => Skill::Layer,
         }
     }
 
@@ -120,166 +127,35 @@ pub struct EnvChoice {
     pub angle_threshold: f64,
 }
 
-/// The paper's angle threshold for both atomic actions, radians.
-pub const PAPER_ANGLE_THRESHOLD: f64 = 0.1;
-
 impl EnvChoice {
-    /// The object, checked to suit the environment.
-    pub fn object(&self) -> anyhow::Result<ObjectKind> {
-        suited(
-            self.env,
-            self.object.unwrap_or(match self.env {
-                EnvKind::Rot => ObjectKind::Rigid,
-                EnvKind::Layer => ObjectKind::Cube,
-            }),
-        )
+    /// The flags as an environment's settings.
+    pub fn settings(&self) -> EnvSettings {
+        EnvSettings {
+            mode: (self.env == EnvKind::Rot).then(|| self.mode.name().to_string()),
+            layer_move: (self.env == EnvKind::Layer).then(|| self.layer_move.name().to_string()),
+            object: self.object.map(|o| o.name().to_string()),
+            square: self.square,
+            intact: self.intact,
+            turn_ends: self.turn_ends,
+            see_misalignment: self.see_misalignment,
+            see_grip: self.see_grip,
+            control_substeps: Some(self.control_rate.substeps()),
+            angle_threshold: Some(self.angle_threshold),
+            ..EnvSettings::default()
+        }
+    }
+
+    /// The chosen environment, checked.
+    pub fn spec(&self) -> anyhow::Result<EnvSpec> {
+        self.settings()
+            .resolve(self.env.skill())
+            .map_err(anyhow::Error::msg)
     }
 
     /// Builds the chosen environment; LayerOpEnv samples training goals.
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
-        let scene = Scene::load(self.object()?.scene())?;
-        let settings = EpisodeSettings {
-            rate: self.control_rate,
-            ..EpisodeSettings::PAPER
-        };
-        Ok(match self.env {
-            EnvKind::Rot => Box::new(
-                CubeRotEnv::with_scene(scene, self.rot_goal()?)
-                    .with_view(self.view()?)
-                    .with_settings(settings),
-            ),
-            EnvKind::Layer => Box::new(
-                LayerOpEnv::with_scene(scene, self.layer_move, LayerGoals::Training)
-                    .with_goal(self.layer_goal()?)
-                    .with_view(self.view()?)
-                    .with_settings(settings),
-            ),
-        })
-    }
-
-    /// What the environment shows the policy beyond the paper's observations
-    /// (`--see-misalignment`, `--see-grip`, which only the physical cube can be asked for).
-    pub fn view(&self) -> anyhow::Result<View> {
-        for (flag, asked) in [
-            ("--see-misalignment", self.see_misalignment),
-            ("--see-grip", self.see_grip),
-        ] {
-            if asked && self.object()? != ObjectKind::Cube {
-                bail!("{flag} is for the physical cube: use --object cube");
-            }
-        }
-        Ok(View {
-            misalignment: self.see_misalignment,
-            grip: self.see_grip,
-        })
-    }
-
-    /// Whether the success test needs the cube left square (`--square`, which only the
-    /// physical cube can be asked for).
-    pub fn square(&self) -> anyhow::Result<bool> {
-        let square = self.square || self.intact()?;
-        if square && self.object()? != ObjectKind::Cube {
-            bail!(
-                "{} is for the physical cube, whose layers can be left out of line: add \
-                 --object cube",
-                if self.square { "--square" } else { "--intact" }
-            );
-        }
-        Ok(square)
-    }
-
-    /// Whether CubeRotEnv's success test needs the cube intact (`--intact`); LayerOpEnv's
-    /// turns a layer by design.
-    pub fn intact(&self) -> anyhow::Result<bool> {
-        if self.intact && self.env != EnvKind::Rot {
-            bail!(
-                "--intact is for CubeRotEnv (Stage 1), which re-poses the cube without turning a \
-                 layer; LayerOpEnv's task is to turn one"
-            );
-        }
-        Ok(self.intact)
-    }
-
-    /// CubeRotEnv's success test: the paper's in the chosen mode, or with `--square` the
-    /// good state as well, with `--intact` no layer turned too, and with `--turn-ends` the
-    /// episode ended at a turn.
-    pub fn rot_goal(&self) -> anyhow::Result<RotGoal> {
-        let paper = RotGoal {
-            angle_threshold: self.angle_threshold,
-            ..RotGoal::paper(self.mode)
-        };
-        Ok(match (self.square()?, self.intact()?, self.turn_ends) {
-            (_, true, true) => paper.ending_on_turn(),
-            (_, true, false) => paper.left_intact(),
-            (true, false, _) => paper.left_square(),
-            (false, false, _) => paper,
-        })
-    }
-
-    /// How the success test's name goes on after the stage's own part, `cube` naming the
-    /// object or not: ", left square" (", cube left square"), then " and intact" with
-    /// `--intact`, and how a turn ends the episode with `--turn-ends`.
-    pub fn success_suffix(&self, cube: &str) -> anyhow::Result<String> {
-        let square = if self.square()? {
-            format!(", {cube}left square")
-        } else {
-            String::new()
-        };
-        let intact = match (self.intact()?, self.turn_ends) {
-            (true, true) => " and intact, a turn ending the episode",
-            (true, false) => " and intact",
-            (false, _) => "",
-        };
-        Ok(square + intact)
-    }
-
-    /// LayerOpEnv's success test: the paper's, or with `--square` the good state as well.
-    pub fn layer_goal(&self) -> anyhow::Result<LayerGoal> {
-        let goal = if self.square()? {
-            LayerGoal::square()
-        } else {
-            LayerGoal::default()
-        };
-        Ok(LayerGoal {
-            angle_threshold: self.angle_threshold,
-            ..goal
-        })
-    }
-
-    /// The run's label. Runs on each environment's original object keep the label they had
-    /// before the object was an option, so they resume.
-    pub fn name(&self) -> anyhow::Result<String> {
-        let what = match self.env {
-            EnvKind::Rot => format!("CubeRotEnv ({} mode", self.mode.name()),
-            EnvKind::Layer => format!("LayerOpEnv ({}", self.layer_move.name()),
-        };
-        let square = self.success_suffix("")?;
-        let seen = self
-            .view()?
-            .name()
-            .map(|name| format!(", {name} seen"))
-            .unwrap_or_default()
-            + &if self.control_rate == ControlRate::PAPER {
-                String::new()
-            } else {
-                format!(", acting every {} substeps", self.control_rate)
-            }
-            + &if self.angle_threshold == PAPER_ANGLE_THRESHOLD {
-                String::new()
-            } else {
-                format!(", trained to {} rad", self.angle_threshold)
-            };
-        Ok(match self.named_object()? {
-            None => format!("{what}{square}{seen})"),
-            Some(object) => format!("{what}, {}{square}{seen})", object.name()),
-        })
-    }
-
-    /// The object, when it is not the environment's original one and so is named in the
-    /// run's label and folder.
-    pub fn named_object(&self) -> anyhow::Result<Option<ObjectKind>> {
-        let object = self.object()?;
-        Ok((object != original_object(self.env)).then_some(object))
+        let make = self.spec()?.maker(None).map_err(anyhow::Error::msg)?;
+        Ok(make())
     }
 }
 
@@ -313,10 +189,7 @@ pub fn angle_flag(flag: &str, hint: &str, text: &str) -> Result<f64, String> {
 /// The object each environment held before the object was an option: runs and cards on it
 /// keep their old names.
 pub fn original_object(env: EnvKind) -> ObjectKind {
-    match env {
-        EnvKind::Rot => ObjectKind::Rigid,
-        EnvKind::Layer => ObjectKind::Block,
-    }
+    env.skill().original_object()
 }
 
 /// `object`, if `env` can hold it.
@@ -361,9 +234,10 @@ pub fn run(command: EnvCommand) -> anyhow::Result<ExitCode> {
 }
 
 fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
+    let spec = choice.spec()?;
     let env = choice.build()?;
     let spaces = env.spaces();
-    println!("{}", choice.name()?);
+    println!("{}", spec.name());
     println!("  observation: {} floats", spaces.observation);
     println!(
         "  goal:        {} floats (achieved_goal and desired_goal)",
@@ -377,7 +251,7 @@ fn info(choice: &EnvChoice) -> anyhow::Result<ExitCode> {
         "  episode:     {} control steps of 20 x 0.002 s",
         dexcube_env::EPISODE_STEPS
     );
-    let square = match (choice.square()?, choice.intact()?) {
+    let square = match (spec.square, spec.intact) {
         (_, true) => ", every cubelet within 0.1 rad of a quarter turn, no layer turned",
         (true, false) => ", every cubelet within 0.1 rad of a quarter turn",
         (false, false) => "",
@@ -406,7 +280,7 @@ fn rollout(args: &RolloutArgs) -> anyhow::Result<ExitCode> {
     let mut successes = 0;
     println!(
         "{} with the {} policy, seed {}",
-        args.choice.name()?,
+        args.choice.spec()?.name(),
         policy_name(args.policy),
         args.seed
     );

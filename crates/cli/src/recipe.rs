@@ -5,197 +5,44 @@
 //! A recipe is data: `dexcube train rot --print-recipe` prints one as JSON, and `--recipe
 //! FILE` runs a file of that form.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Context, bail};
-use dexcube_env::layer::LayerGoals;
-use dexcube_env::{
-    ControlRate, CubeRotEnv, EpisodeSettings, GoalEnv, LayerOpEnv, StartMix, StartPick,
-};
+use dexcube_env::{EnvSettings, GoalEnv};
 use dexcube_rl::DdpgHerConfig;
 use dexcube_rl::recipe::{Phase, PhaseEnvs, Recipe};
 use dexcube_rl::train::Until;
 use dexcube_sim::Scene;
 use serde::{Deserialize, Serialize};
 
-use crate::env::{
-    EnvChoice, EnvKind, PAPER_ANGLE_THRESHOLD, angle_flag, physics_spread, starts_for,
-};
+use crate::env::{EnvKind, starts_for};
 
-/// What one phase trains on: the settings `dexcube env info` takes as flags, under the flags'
-/// names (`see_misalignment` for `--see-misalignment`), with the same defaults.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PhaseEnv {
-    /// CubeRotEnv's success test: paper, axis or pair.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub mode: Option<String>,
-    /// LayerOpEnv's move: U U' R R' F F'.
-    #[serde(rename = "move", skip_serializing_if = "Option::is_none")]
-    pub layer_move: Option<String>,
-    /// cube, block or rigid (the environment's own by default).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub object: Option<String>,
-    pub square: bool,
-    pub intact: bool,
-    pub turn_ends: bool,
-    pub see_misalignment: bool,
-    pub see_grip: bool,
-    /// LayerOpEnv: train on the evaluation goal, exactly a quarter turn, not goals up to it.
-    pub quarter_goals: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub control_substeps: Option<usize>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub angle_threshold: Option<f64>,
-    /// Domain randomisation: friction, the object's mass and joint damping each scaled per
-    /// episode by a factor log-uniform in [1/(1+S), 1+S].
-    pub physics_spread: f64,
-    /// Recorded starts (`dexcube eval --record-starts`) to begin a share of episodes from.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub starts: Option<PathBuf>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub start_share: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub failed_weight: Option<f64>,
-}
+/// What one phase trains on: an environment's settings (`dexcube_env::EnvSettings`), under
+/// the names of `dexcube env`'s flags.
+pub type PhaseEnv = EnvSettings;
 
-impl PhaseEnv {
-    /// The environment these settings choose for `skill`, checked as `dexcube env` checks
-    /// its flags.
-    fn choice(&self, skill: EnvKind) -> anyhow::Result<EnvChoice> {
-        if skill == EnvKind::Rot && (self.layer_move.is_some() || self.quarter_goals) {
-            bail!("move and quarter_goals are LayerOpEnv's (train layer)");
+/// The environments of a phase of `skill` with `settings`, with their label and the facts a
+/// policy card records of them; recorded starts are read from their file.
+pub fn phase_envs(
+    settings: &EnvSettings,
+    skill: EnvKind,
+) -> anyhow::Result<PhaseEnvs<Box<dyn GoalEnv>>> {
+    let spec = settings
+        .resolve(skill.skill())
+        .map_err(anyhow::Error::msg)?;
+    let starts = match &spec.starts {
+        Some(setting) => {
+            let scene = Scene::load(spec.object.scene())?;
+            Some(starts_for(&setting.path, &scene, skill)?.0)
         }
-        if skill == EnvKind::Layer && self.mode.is_some() {
-            bail!("mode is CubeRotEnv's success test (train rot)");
-        }
-        let mode = self.mode.as_deref().unwrap_or("paper");
-        let layer_move = self.layer_move.as_deref().unwrap_or("U'");
-        let angle_threshold = self.angle_threshold.unwrap_or(PAPER_ANGLE_THRESHOLD);
-        angle_flag("angle_threshold", "", &angle_threshold.to_string())
-            .map_err(anyhow::Error::msg)?;
-        physics_spread(&self.physics_spread.to_string()).map_err(anyhow::Error::msg)?;
-        Ok(EnvChoice {
-            env: skill,
-            mode: mode.parse().map_err(anyhow::Error::msg)?,
-            layer_move: layer_move.parse().map_err(anyhow::Error::msg)?,
-            object: self
-                .object
-                .as_deref()
-                .map(str::parse)
-                .transpose()
-                .map_err(anyhow::Error::msg)?,
-            square: self.square,
-            intact: self.intact,
-            turn_ends: self.turn_ends,
-            see_misalignment: self.see_misalignment,
-            see_grip: self.see_grip,
-            control_rate: match self.control_substeps {
-                Some(n) => ControlRate::every(n).map_err(anyhow::Error::msg)?,
-                None => ControlRate::PAPER,
-            },
-            angle_threshold,
-        })
-    }
-
-    /// The environments of a phase of `skill` with these settings, with their label and the
-    /// facts a policy card records of them.
-    pub fn envs(&self, skill: EnvKind) -> anyhow::Result<PhaseEnvs<Box<dyn GoalEnv>>> {
-        let choice = self.choice(skill)?;
-        let object = choice.object()?;
-        let view = choice.view()?;
-        if self.starts.is_none() && (self.start_share.is_some() || self.failed_weight.is_some()) {
-            bail!("start_share and failed_weight weigh recorded starts: name them in starts");
-        }
-        let share = self.start_share.unwrap_or(0.5);
-        let failed_weight = self.failed_weight.unwrap_or(1.0);
-        if !(0.0..=1.0).contains(&share) {
-            bail!("start_share must be between 0 and 1, not {share}");
-        }
-        if !(failed_weight.is_finite() && failed_weight > 0.0) {
-            bail!("failed_weight must be a positive number, not {failed_weight}");
-        }
-        if self.starts.is_some()
-            && skill == EnvKind::Layer
-            && self.layer_move.as_deref().is_some_and(|m| m != "U'")
-        {
-            bail!(
-                "starts for layer are the operator's Stage 2 starts: train them with the move U'"
-            );
-        }
-        let scene = Scene::load(object.scene())?;
-        let starts = match &self.starts {
-            Some(path) => Some(StartMix {
-                starts: starts_for(path, &scene, skill)?.0,
-                pick: StartPick::Share {
-                    share,
-                    failed_weight,
-                },
-            }),
-            None => None,
-        };
-        let settings = EpisodeSettings {
-            rate: choice.control_rate,
-            physics_spread: self.physics_spread,
-            ..EpisodeSettings::PAPER
-        };
-        let metadata = serde_json::json!({
-            "env": skill.name(),
-            "goals": if self.quarter_goals { "quarter turn" } else { "uniform" },
-            "success": format!(
-                "{}{}",
-                match skill {
-                    EnvKind::Rot => "pose",
-                    EnvKind::Layer => "angle",
-                },
-                choice.success_suffix("cube ")?
-            ),
-            "observation": view.name().map_or("paper".to_string(), |name| format!("with the {name}")),
-            "object": object.name(),
-            "mode": (skill == EnvKind::Rot).then(|| choice.mode.name()),
-            "starts": self.starts.as_ref().map(|p| p.display().to_string()),
-            "start_share": self.starts.as_ref().map(|_| share),
-            "failed_weight": self.starts.as_ref().map(|_| failed_weight),
-            "control_substeps": choice.control_rate.substeps(),
-            "physics_spread": self.physics_spread,
-            "angle_threshold": choice.angle_threshold,
-        });
-        let make: Box<dyn Fn() -> Box<dyn GoalEnv>> = match skill {
-            EnvKind::Rot => {
-                let goal = choice.rot_goal()?;
-                Box::new(move || {
-                    Box::new(
-                        CubeRotEnv::with_scene(scene.clone(), goal)
-                            .with_view(view)
-                            .with_starts(starts.clone())
-                            .with_settings(settings),
-                    ) as Box<dyn GoalEnv>
-                })
-            }
-            EnvKind::Layer => {
-                let (layer_move, goal) = (choice.layer_move, choice.layer_goal()?);
-                let goals = if self.quarter_goals {
-                    LayerGoals::Evaluation
-                } else {
-                    LayerGoals::Training
-                };
-                Box::new(move || {
-                    Box::new(
-                        LayerOpEnv::with_scene(scene.clone(), layer_move, goals)
-                            .with_goal(goal)
-                            .with_view(view)
-                            .with_starts(starts.clone())
-                            .with_settings(settings),
-                    ) as Box<dyn GoalEnv>
-                })
-            }
-        };
-        Ok(PhaseEnvs {
-            make,
-            label: choice.name()?,
-            metadata,
-        })
-    }
+        None => None,
+    };
+    let make = spec.maker(starts).map_err(anyhow::Error::msg)?;
+    Ok(PhaseEnvs {
+        make: Box::new(move || make()),
+        label: spec.name(),
+        metadata: spec.card_facts(),
+    })
 }
 
 /// A recipe as a run keeps it (`DIR/recipe.json`): the skill, the seed and the recipe.
@@ -375,7 +222,7 @@ mod tests {
                 let recipe = shipped(name, skill).expect("shipped");
                 recipe.check().unwrap();
                 for phase in &recipe.phases {
-                    let envs = phase.env.envs(skill).unwrap();
+                    let envs = phase_envs(&phase.env, skill).unwrap();
                     let mut env = (envs.make)();
                     env.reset(Some(0));
                     let action = vec![0.0; env.spaces().action];

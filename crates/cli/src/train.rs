@@ -137,7 +137,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<ExitCode> {
         progress: true,
     };
     let outcome = run_recipe(&file.recipe, &run, |env: &PhaseEnv| {
-        env.envs(skill).map_err(|e| format!("{e:#}"))
+        crate::recipe::phase_envs(env, skill).map_err(|e| format!("{e:#}"))
     })?;
     let last = outcome.metrics.last();
     eprintln!(

@@ -570,7 +570,7 @@ fn each_environment_takes_only_objects_it_can_hold() {
     }
     for other in [&["layer", "--object", "block"][..], &["rot"]] {
         let args = [&["env", "info"][..], other, &["--square"]].concat();
-        assert_clean_failure(&dexcube(&args, ""), 2, "--square is for the physical cube");
+        assert_clean_failure(&dexcube(&args, ""), 2, "square is for the physical cube");
     }
     // A tighter training threshold is the success test's, and names the environment.
     for (env, test) in [
@@ -639,27 +639,27 @@ fn train_refuses_recipes_it_cannot_run() {
         (
             "rot",
             serde_json::json!({"square": true}),
-            "--square is for the physical cube",
+            "square is for the physical cube",
         ),
         (
             "layer",
             serde_json::json!({"object": "block", "see_misalignment": true}),
-            "--see-misalignment is for the physical cube",
+            "see_misalignment is for the physical cube",
         ),
         (
             "rot",
             serde_json::json!({"see_grip": true}),
-            "--see-grip is for the physical cube",
+            "see_grip is for the physical cube",
         ),
         (
             "rot",
             serde_json::json!({"intact": true}),
-            "--intact is for the physical cube",
+            "intact is for the physical cube",
         ),
         (
             "layer",
             serde_json::json!({"intact": true}),
-            "--intact is for CubeRotEnv",
+            "intact is for CubeRotEnv",
         ),
         (
             "layer",
@@ -684,7 +684,7 @@ fn train_refuses_recipes_it_cannot_run() {
         (
             "rot",
             serde_json::json!({"physics_spread": -0.1}),
-            "--physics-spread must be 0 or more",
+            "physics_spread must be 0 or more",
         ),
         (
             "layer",

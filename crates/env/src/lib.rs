@@ -16,6 +16,8 @@
 //! - [`RecordedStart`]: where the operator began a stage, for CubeRotEnv and LayerOpEnv to
 //!   reset from.
 //! - [`VecEnv`]: many environments stepped on a thread pool, each with its own `MjData`.
+//! - [`EnvSettings`] and [`EnvSpec`]: an environment as settings, checked once, whether they
+//!   come from the command line, a recipe or Python.
 //!
 //! Dynamics follow Gymnasium-Robotics' hand environments: an action in [-1, 1]^20 maps onto
 //! the actuators' control ranges as absolute joint targets, a control step is 20 substeps of
@@ -26,6 +28,7 @@ mod hand_object;
 pub mod layer;
 pub mod random;
 pub mod rot;
+pub mod spec;
 pub mod starts;
 pub mod vec_env;
 
@@ -39,6 +42,7 @@ pub use hand_object::{
 };
 pub use layer::{CubeLayer, LayerMove, LayerOpEnv};
 pub use rot::{CubeRotEnv, achieved_goal, cube_misalignment, pose_goal, rot_observation};
+pub use spec::{EnvMaker, EnvSettings, EnvSpec, PAPER_ANGLE_THRESHOLD, Skill, StartsSetting};
 pub use starts::{RecordedFailure, RecordedStart, StartMix, StartPick};
 pub use vec_env::VecEnv;
 
