@@ -155,7 +155,7 @@ impl EnvChoice {
     /// Builds the chosen environment; LayerOpEnv samples training goals.
     pub fn build(&self) -> anyhow::Result<Box<dyn GoalEnv>> {
         let make = self.spec()?.maker(None).map_err(anyhow::Error::msg)?;
-        Ok(make())
+        Ok(make() as Box<dyn GoalEnv>)
     }
 }
 

@@ -39,7 +39,7 @@ pub fn phase_envs(
     };
     let make = spec.maker(starts).map_err(anyhow::Error::msg)?;
     Ok(PhaseEnvs {
-        make: Box::new(move || make()),
+        make: Box::new(move || make() as Box<dyn GoalEnv>),
         label: spec.name(),
         metadata: spec.card_facts(),
     })

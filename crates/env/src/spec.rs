@@ -15,7 +15,7 @@ use crate::hand_object::{EpisodeSettings, ObjectKind, View};
 use crate::layer::{LayerGoals, LayerMove, LayerOpEnv};
 use crate::rot::CubeRotEnv;
 use crate::starts::{RecordedStart, StartMix, StartPick};
-use crate::{ControlRate, GoalEnv, SimError};
+use crate::{ControlRate, SimError, SimulatedEnv};
 
 /// The paper's angle threshold for both atomic actions, radians.
 pub const PAPER_ANGLE_THRESHOLD: f64 = 0.1;
@@ -132,8 +132,9 @@ pub struct EnvSpec {
     pub starts: Option<StartsSetting>,
 }
 
-/// Makes environments of one spec, as many as a vectorised run steps.
-pub type EnvMaker = Arc<dyn Fn() -> Box<dyn GoalEnv> + Send + Sync>;
+/// Makes environments of one spec, as many as a vectorised run steps. Each is a
+/// [`SimulatedEnv`], so that it can be rendered too, and a goal environment as it stands.
+pub type EnvMaker = Arc<dyn Fn() -> Box<dyn SimulatedEnv> + Send + Sync>;
 
 impl EnvSettings {
     /// The settings checked for `skill`; says what is wrong with the first that does not fit.
@@ -408,7 +409,7 @@ impl EnvSpec {
                             .with_view(view)
                             .with_starts(starts.clone())
                             .with_settings(settings),
-                    ) as Box<dyn GoalEnv>
+                    ) as Box<dyn SimulatedEnv>
                 })
             }
             Skill::Layer => {
@@ -425,7 +426,7 @@ impl EnvSpec {
                             .with_view(view)
                             .with_starts(starts.clone())
                             .with_settings(settings),
-                    ) as Box<dyn GoalEnv>
+                    ) as Box<dyn SimulatedEnv>
                 })
             }
         })

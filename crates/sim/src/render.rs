@@ -65,6 +65,11 @@ impl FrameRenderer {
         })
     }
 
+    /// The frames' (width, height).
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
     /// Renders the simulation as it is now.
     pub fn render(&mut self, sim: &mut Sim) -> Result<Frame, SimError> {
         let fail = |e: mujoco_rs::renderer::RendererError| SimError::Render {
