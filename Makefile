@@ -1,6 +1,6 @@
 # The two commands of the README. Both run the set-up first; it is quick once done.
 #   make demo   set up, build, and run the main job on the shipped defaults
-#   make test   set up, build, and run every test
+#   make test   set up, build, and run every test (the Rust crates', then the Python package's)
 # Extra arguments for the demo: make demo ARGS="--distance 9 --seed 4"
 
 CARGO ?= cargo
@@ -13,6 +13,7 @@ demo: setup
 
 test: setup
 	$(CARGO) test --release --workspace
+	./scripts/test-python
 
 lint: setup
 	$(CARGO) fmt --all --check
