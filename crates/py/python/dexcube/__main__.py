@@ -1,0 +1,5 @@
+"""``python -m dexcube`` runs the benchmark (``dexcube.bench``)."""
+
+from .bench import main
+
+main()
