@@ -81,7 +81,7 @@ fn info<'py>(py: Python<'py>, info: &dexcube_env::Info) -> PyResult<Bound<'py, P
 /// The rewards of `n` (achieved, desired) goal rows, laid out row after row.
 fn rewards(goal: &dyn Goal, achieved: &[f64], desired: &[f64]) -> PyResult<Vec<f64>> {
     let size = goal.size();
-    if achieved.len() != desired.len() || achieved.len() % size != 0 {
+    if achieved.len() != desired.len() || !achieved.len().is_multiple_of(size) {
         return Err(bad(format!(
             "achieved and desired goals must be rows of {size} numbers alike, not {} and {} numbers",
             achieved.len(),
