@@ -226,23 +226,48 @@ pub struct ReplayPosition {
 /// The first bytes of a file of episodes.
 const EPISODES_MAGIC: &[u8; 8] = b"DXEPIS01";
 
-/// Episodes of environments of `dims` as bytes, exactly: a header, their count, then each
-/// episode's length, whether it ended in an absorbing failure, and its rows (little-endian
-/// `f64` observations and goals, `f32` actions).
-pub fn episodes_to_bytes(dims: Dims, episodes: &[Episode]) -> Vec<u8> {
-    let mut out = EPISODES_MAGIC.to_vec();
-    for size in [dims.observation, dims.goal, dims.action, episodes.len()] {
-        out.extend((size as u64).to_le_bytes());
-    }
-    for e in episodes {
-        out.extend((e.len as u64).to_le_bytes());
-        out.push(e.terminated as u8);
-        for values in [&e.observation, &e.achieved_goal, &e.desired_goal] {
-            values.iter().for_each(|v| out.extend(v.to_le_bytes()));
+/// Episodes of environments of `dims` as bytes, exactly, written one at a time as they are
+/// stored: a header, their count, then each episode's length, whether it ended in an absorbing
+/// failure, and its rows (little-endian `f64` observations and goals, `f32` actions).
+pub struct EpisodeFile {
+    dims: Dims,
+    count: usize,
+    body: Vec<u8>,
+}
+
+impl EpisodeFile {
+    pub fn new(dims: Dims) -> EpisodeFile {
+        EpisodeFile {
+            dims,
+            count: 0,
+            body: Vec::new(),
         }
-        e.action.iter().for_each(|v| out.extend(v.to_le_bytes()));
     }
-    out
+
+    pub fn push(&mut self, e: &Episode) {
+        self.count += 1;
+        self.body.extend((e.len as u64).to_le_bytes());
+        self.body.push(e.terminated as u8);
+        for values in [&e.observation, &e.achieved_goal, &e.desired_goal] {
+            values
+                .iter()
+                .for_each(|v| self.body.extend(v.to_le_bytes()));
+        }
+        e.action
+            .iter()
+            .for_each(|v| self.body.extend(v.to_le_bytes()));
+    }
+
+    /// The file's bytes, which [`episodes_from_bytes`] reads back.
+    pub fn into_bytes(self) -> Vec<u8> {
+        let d = self.dims;
+        let mut out = EPISODES_MAGIC.to_vec();
+        for size in [d.observation, d.goal, d.action, self.count] {
+            out.extend((size as u64).to_le_bytes());
+        }
+        out.extend(self.body);
+        out
+    }
 }
 
 /// Reads a byte string front to back, saying where it ends too soon.
@@ -275,7 +300,7 @@ impl<'a> Bytes<'a> {
     }
 }
 
-/// The episodes [`episodes_to_bytes`] wrote for environments of `dims`; says what is wrong
+/// The episodes an [`EpisodeFile`] wrote for environments of `dims`; says what is wrong
 /// with bytes that are not such a file, are cut short, or were written for other sizes.
 pub fn episodes_from_bytes(dims: Dims, bytes: &[u8]) -> Result<Vec<Episode>, String> {
     let mut input = Bytes { bytes, at: 0 };

@@ -41,7 +41,7 @@ use crate::config::DdpgHerConfig;
 use crate::normalizer::Normalizer;
 use crate::plot::{Series, line_plot};
 use crate::policy::Policy;
-use crate::replay::{Episode, HerBuffer, ReplayPosition, episodes_from_bytes, episodes_to_bytes};
+use crate::replay::{EpisodeFile, HerBuffer, ReplayPosition, episodes_from_bytes};
 use crate::rollout::rollout;
 
 pub struct TrainOptions {
@@ -454,7 +454,7 @@ pub fn train<E: GoalEnv>(
             Learners::ActorAndCritic
         };
         let first_stored = buffer.position().stored;
-        let mut epoch_episodes: Vec<Episode> = Vec::new();
+        let mut epoch_episodes = EpisodeFile::new(dims);
         for cycle in 0..cycles {
             let t = Instant::now();
             let (episodes, s) = rollout(
@@ -476,7 +476,7 @@ pub fn train<E: GoalEnv>(
                     agent.goal_norm.update(g);
                 }
                 if options.out_dir.is_some() {
-                    epoch_episodes.push(episode.clone());
+                    epoch_episodes.push(&episode);
                 }
                 buffer.store(episode);
             }
@@ -547,7 +547,7 @@ pub fn train<E: GoalEnv>(
                 first: first_stored,
                 stored: position.stored - first_stored,
             };
-            let bytes = episodes_to_bytes(dims, &epoch_episodes);
+            let bytes = epoch_episodes.into_bytes();
             checkpoint::write_atomically(&Segment::path(dir, epoch), &bytes)?;
             replay = replay.after(segment, position);
             let run = SavedRun {
